@@ -1,0 +1,436 @@
+//! The [`Element`] trait: what every bond-graph element, field, junction and signal block
+//! implements, and the [`Io`] view through which it reads and writes its variables.
+//!
+//! Sign convention (see `docs/conventions.md`): an element sees its ports with *power in*
+//! positive. [`Io::f_in`] is the flow into the element (the bond's flow if the half-arrow points
+//! at the element, its negative otherwise); efforts are never sign-flipped.
+
+use std::fmt::Debug;
+
+use crate::bond::PortCausality;
+
+/// Port signature of an element.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Ports {
+    /// Fixed ports, in order, each with its dimension (`None`: takes the bond's dimension).
+    Fixed(Vec<PortSpec>),
+    /// Any number of ports of one common dimension (junctions).
+    Any,
+}
+
+/// One port of an element.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PortSpec {
+    /// Port name used in model files (`"1"`, `"2"`, `"mech"`, …).
+    pub name: String,
+    /// Dimension of the port, or `None` if it adapts to the bond.
+    pub dim: Option<usize>,
+}
+
+impl PortSpec {
+    /// A port of fixed dimension.
+    #[must_use]
+    pub fn new(name: &str, dim: usize) -> Self {
+        Self { name: name.to_owned(), dim: Some(dim) }
+    }
+    /// A port that takes the dimension of its bond.
+    #[must_use]
+    pub fn any_dim(name: &str) -> Self {
+        Self { name: name.to_owned(), dim: None }
+    }
+}
+
+/// A state of an element (a momentum, a displacement, a block state).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StateSpec {
+    /// Name, unique within the element (`p`, `q`, `x_v`, `q[2]`).
+    pub name: String,
+    /// Initial value.
+    pub initial: f64,
+    /// Typical magnitude: the absolute tolerance of this state is `atol · nominal`.
+    pub nominal: f64,
+}
+
+impl StateSpec {
+    /// A state with nominal magnitude 1.
+    #[must_use]
+    pub fn new(name: &str, initial: f64) -> Self {
+        Self { name: name.to_owned(), initial, nominal: 1.0 }
+    }
+    /// Set the nominal magnitude used to scale the absolute tolerance.
+    #[must_use]
+    pub fn nominal(mut self, nominal: f64) -> Self {
+        self.nominal = nominal;
+        self
+    }
+}
+
+/// A named signal an element reads or publishes.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SignalSpec {
+    /// Local name (`x_v`, `y`).
+    pub name: String,
+    /// Number of scalars (1 for a scalar signal).
+    pub dim: usize,
+}
+
+impl SignalSpec {
+    /// A scalar signal.
+    #[must_use]
+    pub fn scalar(name: &str) -> Self {
+        Self { name: name.to_owned(), dim: 1 }
+    }
+}
+
+/// The causal constraints of an element, used by [`assign_causality`](crate::assign_causality).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum CausalRule {
+    /// One admissible pattern, not a storage (Se, Sf, a one-way MTF): applied first.
+    Fixed(Vec<PortCausality>),
+    /// A storage element in integral causality; any other pattern is derivative causality, refused.
+    Integral(Vec<PortCausality>),
+    /// Any one of these patterns, in order of preference (R).
+    Resistive(Vec<Vec<PortCausality>>),
+    /// Exactly one port has this causality, all others the opposite
+    /// (0-junction: `FlowOut`; 1-junction: `EffortOut`; TF: either).
+    ExactlyOne(PortCausality),
+    /// All ports have the same causality (GY).
+    AllEqual,
+    /// No ports (signal blocks).
+    None,
+}
+
+/// A variable an element reads or writes: a port's effort or flow, a signal input or output.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Slot {
+    /// Effort of port `i`.
+    Effort(usize),
+    /// Flow of port `i`.
+    Flow(usize),
+    /// Signal input `i`.
+    Input(usize),
+    /// Signal output `i`.
+    Output(usize),
+}
+
+/// One step of an element's computation: it writes `writes` from `reads` (and states and time).
+///
+/// Elements split their work into stages so that the evaluation plan has no false algebraic
+/// loops: a 0-junction distributes its effort and sums its flows in two independent stages.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Stage {
+    /// Variables computed by this stage.
+    pub writes: Vec<Slot>,
+    /// Variables this stage needs.
+    pub reads: Vec<Slot>,
+}
+
+impl Stage {
+    /// The default: one stage writing every output from every input.
+    #[must_use]
+    pub fn single(causality: &[PortCausality], n_inputs: usize, n_outputs: usize) -> Vec<Stage> {
+        let mut stage = Stage::default();
+        for (i, c) in causality.iter().enumerate() {
+            match c {
+                PortCausality::EffortOut => {
+                    stage.writes.push(Slot::Effort(i));
+                    stage.reads.push(Slot::Flow(i));
+                }
+                PortCausality::FlowOut => {
+                    stage.writes.push(Slot::Flow(i));
+                    stage.reads.push(Slot::Effort(i));
+                }
+            }
+        }
+        stage.reads.extend((0..n_inputs).map(Slot::Input));
+        stage.writes.extend((0..n_outputs).map(Slot::Output));
+        vec![stage]
+    }
+
+    /// A stage computing outputs from states only (storage elements): writes every
+    /// `EffortOut` effort / `FlowOut` flow and all signal outputs, reading only signal inputs.
+    #[must_use]
+    pub fn from_states(causality: &[PortCausality], n_inputs: usize, n_outputs: usize) -> Vec<Stage> {
+        let mut stage = Stage::default();
+        for (i, c) in causality.iter().enumerate() {
+            stage.writes.push(match c {
+                PortCausality::EffortOut => Slot::Effort(i),
+                PortCausality::FlowOut => Slot::Flow(i),
+            });
+        }
+        stage.reads.extend((0..n_inputs).map(Slot::Input));
+        stage.writes.extend((0..n_outputs).map(Slot::Output));
+        vec![stage]
+    }
+}
+
+/// A bond-graph element: its ports, causal constraints, states and constitutive law.
+///
+/// Only [`kind`](Element::kind), [`ports`](Element::ports), [`causal_rule`](Element::causal_rule)
+/// and [`eval`](Element::eval) are required. Storage elements add [`states`](Element::states),
+/// [`derivatives`](Element::derivatives) and usually [`stages`](Element::stages).
+pub trait Element: Debug {
+    /// Kind as written in model files: `"R"`, `"0"`, `"hydraulics.orifice"`.
+    fn kind(&self) -> &str;
+
+    /// Port signature.
+    fn ports(&self) -> Ports;
+
+    /// Causal constraints, given the number of attached ports.
+    fn causal_rule(&self, n_ports: usize) -> CausalRule;
+
+    /// States with their initial values.
+    fn states(&self) -> Vec<StateSpec> {
+        Vec::new()
+    }
+
+    /// Signals this element reads (resolved by name when the graph is built).
+    fn signal_inputs(&self) -> Vec<SignalSpec> {
+        Vec::new()
+    }
+
+    /// Signals this element publishes as `<element>.<name>`.
+    fn signal_outputs(&self) -> Vec<SignalSpec> {
+        Vec::new()
+    }
+
+    /// How the computation splits into stages for the assigned causality
+    /// (default: one stage, every output from every input).
+    fn stages(&self, causality: &[PortCausality]) -> Vec<Stage> {
+        Stage::single(causality, self.signal_inputs().len(), self.signal_outputs().len())
+    }
+
+    /// Compute the variables written by `stage`.
+    fn eval(&self, stage: usize, io: &mut Io<'_>);
+
+    /// State derivatives `dx` (this element's slice), once every variable is known.
+    fn derivatives(&self, io: &Io<'_>, dx: &mut [f64]) {
+        let _ = (io, dx);
+    }
+
+    /// Energy stored at states `x` (for energy-balance tests), if the element stores any.
+    fn stored_energy(&self, x: &[f64]) -> Option<f64> {
+        let _ = x;
+        None
+    }
+}
+
+/// Where a signal input comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Source {
+    /// Simulation time.
+    Time,
+    /// A state, at this offset in the state vector.
+    State(usize),
+    /// A published signal, at this offset in the signal array.
+    Signal(usize),
+    /// A bond's effort, at this offset in the effort array.
+    Effort(usize),
+    /// A bond's flow, at this offset in the flow array.
+    Flow(usize),
+}
+
+/// Port layout: where a port's bond lives in the effort/flow arrays.
+#[derive(Clone, Debug)]
+pub struct PortLayout {
+    /// Offset of the bond's values.
+    pub offset: usize,
+    /// Bond dimension.
+    pub dim: usize,
+    /// +1 if the half-arrow points into this element, −1 if it points away.
+    pub sign: f64,
+    /// Causality of this port.
+    pub causality: PortCausality,
+}
+
+/// Where everything an element touches lives.
+#[derive(Clone, Debug, Default)]
+pub struct Layout {
+    /// Ports in order.
+    pub ports: Vec<PortLayout>,
+    /// Signal inputs: source and dimension.
+    pub inputs: Vec<(Source, usize)>,
+    /// Signal outputs: offset in the signal array and dimension.
+    pub outputs: Vec<(usize, usize)>,
+    /// Offset of this element's states in the state vector.
+    pub state_offset: usize,
+    /// Number of states.
+    pub n_states: usize,
+}
+
+/// What an element sees while it is evaluated.
+pub struct Io<'a> {
+    pub(crate) t: f64,
+    pub(crate) x: &'a [f64],
+    pub(crate) effort: &'a mut [f64],
+    pub(crate) flow: &'a mut [f64],
+    pub(crate) signals: &'a mut [f64],
+    pub(crate) layout: &'a Layout,
+}
+
+impl<'a> Io<'a> {
+    /// Simulation time.
+    #[must_use]
+    pub fn time(&self) -> f64 {
+        self.t
+    }
+    /// This element's states.
+    #[must_use]
+    pub fn states(&self) -> &[f64] {
+        let l = self.layout;
+        &self.x[l.state_offset..l.state_offset + l.n_states]
+    }
+    /// Number of ports.
+    #[must_use]
+    pub fn n_ports(&self) -> usize {
+        self.layout.ports.len()
+    }
+    /// Dimension of port `port`.
+    #[must_use]
+    pub fn dim(&self, port: usize) -> usize {
+        self.layout.ports[port].dim
+    }
+    /// +1 if the bond at `port` points into the element, −1 otherwise.
+    #[must_use]
+    pub fn sign(&self, port: usize) -> f64 {
+        self.layout.ports[port].sign
+    }
+    /// Causality of `port`.
+    #[must_use]
+    pub fn causality(&self, port: usize) -> PortCausality {
+        self.layout.ports[port].causality
+    }
+    /// Effort vector of `port`.
+    #[must_use]
+    pub fn effort(&self, port: usize) -> &[f64] {
+        let p = &self.layout.ports[port];
+        &self.effort[p.offset..p.offset + p.dim]
+    }
+    /// Flow vector of `port` (the bond's flow, in the half-arrow's direction).
+    #[must_use]
+    pub fn flow(&self, port: usize) -> &[f64] {
+        let p = &self.layout.ports[port];
+        &self.flow[p.offset..p.offset + p.dim]
+    }
+    /// Component `k` of the effort at `port`.
+    #[must_use]
+    pub fn e(&self, port: usize, k: usize) -> f64 {
+        self.effort[self.layout.ports[port].offset + k]
+    }
+    /// Component `k` of the flow *into the element* at `port`.
+    #[must_use]
+    pub fn f_in(&self, port: usize, k: usize) -> f64 {
+        let p = &self.layout.ports[port];
+        p.sign * self.flow[p.offset + k]
+    }
+    /// Set component `k` of the effort at `port`.
+    pub fn set_e(&mut self, port: usize, k: usize, value: f64) {
+        let off = self.layout.ports[port].offset;
+        self.effort[off + k] = value;
+    }
+    /// Set component `k` of the flow *into the element* at `port`.
+    pub fn set_f_in(&mut self, port: usize, k: usize, value: f64) {
+        let p = &self.layout.ports[port];
+        self.flow[p.offset + k] = p.sign * value;
+    }
+    /// Signal input `i` (a slice of its dimension).
+    #[must_use]
+    pub fn input(&self, i: usize) -> &[f64] {
+        let (src, dim) = self.layout.inputs[i];
+        match src {
+            Source::Time => std::slice::from_ref(&self.t),
+            Source::State(o) => &self.x[o..o + dim],
+            Source::Signal(o) => &self.signals[o..o + dim],
+            Source::Effort(o) => &self.effort[o..o + dim],
+            Source::Flow(o) => &self.flow[o..o + dim],
+        }
+    }
+    /// First component of signal input `i`.
+    #[must_use]
+    pub fn u(&self, i: usize) -> f64 {
+        self.input(i)[0]
+    }
+    /// Set signal output `i` (component `k`).
+    pub fn set_y(&mut self, i: usize, k: usize, value: f64) {
+        let (off, _) = self.layout.outputs[i];
+        self.signals[off + k] = value;
+    }
+}
+
+/// A coefficient that is either constant or a function of time and scalar signal inputs
+/// (a *modulated* parameter: the ratio of an MTF, the resistance of a valve, a source value).
+pub enum Param {
+    /// A constant.
+    Const(f64),
+    /// `value = law(t, inputs)`, reading the named scalar signals.
+    Modulated {
+        /// Names of the signals read, in the order `law` receives them.
+        inputs: Vec<String>,
+        /// The law.
+        law: Box<dyn Fn(f64, &[f64]) -> f64>,
+    },
+}
+
+/// Most signal inputs a modulated parameter may read.
+pub const MAX_PARAM_INPUTS: usize = 16;
+
+impl Param {
+    /// A modulated parameter.
+    pub fn modulated(inputs: Vec<String>, law: impl Fn(f64, &[f64]) -> f64 + 'static) -> Self {
+        Self::Modulated { inputs, law: Box::new(law) }
+    }
+    /// Signals read, as specs (scalar).
+    #[must_use]
+    pub fn signal_inputs(&self) -> Vec<SignalSpec> {
+        match self {
+            Self::Const(_) => Vec::new(),
+            Self::Modulated { inputs, .. } => inputs.iter().map(|n| SignalSpec::scalar(n)).collect(),
+        }
+    }
+    /// Number of signal inputs.
+    #[must_use]
+    pub fn n_inputs(&self) -> usize {
+        match self {
+            Self::Const(_) => 0,
+            Self::Modulated { inputs, .. } => inputs.len(),
+        }
+    }
+    /// The constant value, if constant.
+    #[must_use]
+    pub fn constant(&self) -> Option<f64> {
+        match self {
+            Self::Const(v) => Some(*v),
+            Self::Modulated { .. } => None,
+        }
+    }
+    /// Value now; the parameter's inputs are the element's inputs `first..first + n_inputs`.
+    #[must_use]
+    pub fn value(&self, io: &Io<'_>, first: usize) -> f64 {
+        match self {
+            Self::Const(v) => *v,
+            Self::Modulated { inputs, law } => {
+                let mut buf = [0.0; MAX_PARAM_INPUTS];
+                let n = inputs.len().min(MAX_PARAM_INPUTS);
+                for (k, b) in buf.iter_mut().take(n).enumerate() {
+                    *b = io.u(first + k);
+                }
+                law(io.time(), &buf[..n])
+            }
+        }
+    }
+}
+
+impl Debug for Param {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Const(v) => write!(f, "{v}"),
+            Self::Modulated { inputs, .. } => write!(f, "law({})", inputs.join(", ")),
+        }
+    }
+}
+
+impl From<f64> for Param {
+    fn from(v: f64) -> Self {
+        Self::Const(v)
+    }
+}

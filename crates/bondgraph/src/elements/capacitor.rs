@@ -1,0 +1,99 @@
+//! Capacitor `C`: dq/dt = f_in, e = q/c. Stores q²/(2c).
+//!
+//! Causality: integral (effort out); derivative causality is refused. The compliance `c`
+//! may be modulated (a chamber whose volume follows a stroke); then the stored energy is
+//! not conserved, since the modulation does work. On a multibond the law applies
+//! component-wise with one displacement per component.
+
+use crate::bond::PortCausality;
+use crate::element::{CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Stage, StateSpec};
+use crate::elements::component_names;
+use crate::error::ParamError;
+
+/// Capacitor (spring, compliance). Compliance `c` in flow·time/effort (F, m/N, m³/Pa).
+#[derive(Debug)]
+pub struct Capacitor {
+    c: Param,
+    q0: Vec<f64>,
+}
+
+impl Capacitor {
+    /// A scalar capacitor with compliance `c` (> 0 if constant) and initial displacement `q0`.
+    pub fn new(c: impl Into<Param>, q0: f64) -> Result<Self, ParamError> {
+        Self::multi(c, vec![q0])
+    }
+    /// A capacitor on a multibond of dimension `q0.len()`.
+    pub fn multi(c: impl Into<Param>, q0: Vec<f64>) -> Result<Self, ParamError> {
+        let c = c.into();
+        if let Some(v) = c.constant() {
+            ParamError::positive("c", v)?;
+        }
+        if q0.is_empty() {
+            return Err(ParamError::Shape { param: "q0".into(), message: "needs at least one component".into() });
+        }
+        for &q in &q0 {
+            ParamError::finite("q0", q)?;
+        }
+        Ok(Self { c, q0 })
+    }
+}
+
+impl Element for Capacitor {
+    fn kind(&self) -> &str {
+        "C"
+    }
+    fn ports(&self) -> Ports {
+        Ports::Fixed(vec![PortSpec::new("1", self.q0.len())])
+    }
+    fn causal_rule(&self, _: usize) -> CausalRule {
+        CausalRule::Integral(vec![PortCausality::EffortOut])
+    }
+    fn states(&self) -> Vec<StateSpec> {
+        component_names("q", self.q0.len())
+            .iter()
+            .zip(&self.q0)
+            .map(|(n, &q)| StateSpec::new(n, q))
+            .collect()
+    }
+    fn signal_inputs(&self) -> Vec<SignalSpec> {
+        self.c.signal_inputs()
+    }
+    fn stages(&self, causality: &[PortCausality]) -> Vec<Stage> {
+        Stage::from_states(causality, self.c.n_inputs(), 0)
+    }
+    fn eval(&self, _: usize, io: &mut Io<'_>) {
+        let c = self.c.value(io, 0);
+        for k in 0..self.q0.len() {
+            let q = io.states()[k];
+            io.set_e(0, k, q / c);
+        }
+    }
+    fn derivatives(&self, io: &Io<'_>, dx: &mut [f64]) {
+        for (k, d) in dx.iter_mut().enumerate() {
+            *d = io.f_in(0, k);
+        }
+    }
+    fn stored_energy(&self, x: &[f64]) -> Option<f64> {
+        let c = self.c.constant()?;
+        Some(x.iter().map(|q| q * q / (2.0 * c)).sum())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rejects_non_positive_compliance() {
+        assert!(Capacitor::new(0.0, 0.0).is_err());
+        assert!(Capacitor::new(-1e-3, 0.0).is_err());
+        assert!(Capacitor::new(f64::INFINITY, 0.0).is_err());
+        assert!(Capacitor::new(1e-3, f64::NAN).is_err());
+    }
+
+    #[test]
+    fn energy_is_q_squared_over_2c() {
+        let c = Capacitor::new(0.5, 0.0).unwrap();
+        assert_eq!(c.stored_energy(&[2.0]), Some(4.0));
+    }
+}

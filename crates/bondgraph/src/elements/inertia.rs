@@ -1,0 +1,100 @@
+//! Inertia `I`: dp/dt = e, f_in = p/m. Stores p²/(2m).
+//!
+//! Causality: integral (flow out); derivative causality is refused. On a multibond the law
+//! applies component-wise with one momentum per component (a point mass in the plane is an
+//! `I` on a 2-bond).
+
+use crate::bond::PortCausality;
+use crate::element::{CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Stage, StateSpec};
+use crate::elements::component_names;
+use crate::error::ParamError;
+
+/// Inertia (mass, inductance). Inertance `m` in effort·time/flow (kg, H, kg/m⁴).
+#[derive(Debug)]
+pub struct Inertia {
+    m: Param,
+    p0: Vec<f64>,
+}
+
+impl Inertia {
+    /// A scalar inertia with mass `m` (> 0 if constant) and initial momentum `p0`.
+    pub fn new(m: impl Into<Param>, p0: f64) -> Result<Self, ParamError> {
+        Self::multi(m, vec![p0])
+    }
+    /// An inertia on a multibond of dimension `p0.len()`.
+    pub fn multi(m: impl Into<Param>, p0: Vec<f64>) -> Result<Self, ParamError> {
+        let m = m.into();
+        if let Some(v) = m.constant() {
+            ParamError::positive("m", v)?;
+        }
+        if p0.is_empty() {
+            return Err(ParamError::Shape { param: "p0".into(), message: "needs at least one component".into() });
+        }
+        for &p in &p0 {
+            ParamError::finite("p0", p)?;
+        }
+        Ok(Self { m, p0 })
+    }
+}
+
+impl Element for Inertia {
+    fn kind(&self) -> &str {
+        "I"
+    }
+    fn ports(&self) -> Ports {
+        Ports::Fixed(vec![PortSpec::new("1", self.p0.len())])
+    }
+    fn causal_rule(&self, _: usize) -> CausalRule {
+        CausalRule::Integral(vec![PortCausality::FlowOut])
+    }
+    fn states(&self) -> Vec<StateSpec> {
+        component_names("p", self.p0.len())
+            .iter()
+            .zip(&self.p0)
+            .map(|(n, &p)| StateSpec::new(n, p))
+            .collect()
+    }
+    fn signal_inputs(&self) -> Vec<SignalSpec> {
+        self.m.signal_inputs()
+    }
+    fn stages(&self, causality: &[PortCausality]) -> Vec<Stage> {
+        Stage::from_states(causality, self.m.n_inputs(), 0)
+    }
+    fn eval(&self, _: usize, io: &mut Io<'_>) {
+        let m = self.m.value(io, 0);
+        for k in 0..self.p0.len() {
+            let p = io.states()[k];
+            io.set_f_in(0, k, p / m);
+        }
+    }
+    fn derivatives(&self, io: &Io<'_>, dx: &mut [f64]) {
+        for (k, d) in dx.iter_mut().enumerate() {
+            *d = io.e(0, k);
+        }
+    }
+    fn stored_energy(&self, x: &[f64]) -> Option<f64> {
+        let m = self.m.constant()?;
+        Some(x.iter().map(|p| p * p / (2.0 * m)).sum())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rejects_non_positive_mass() {
+        assert!(Inertia::new(0.0, 0.0).is_err());
+        assert!(Inertia::new(-2.0, 0.0).is_err());
+        assert!(Inertia::new(f64::NAN, 0.0).is_err());
+        assert!(Inertia::multi(1.0, vec![]).is_err());
+    }
+
+    #[test]
+    fn multibond_has_one_momentum_per_component() {
+        let i = Inertia::multi(2.0, vec![0.0, 1.0]).unwrap();
+        let names: Vec<_> = i.states().into_iter().map(|s| s.name).collect();
+        assert_eq!(names, ["p[0]", "p[1]"]);
+        assert_eq!(i.stored_energy(&[0.0, 2.0]), Some(1.0));
+    }
+}

@@ -1,0 +1,92 @@
+//! Junctions: `0` (common effort, Σ f_in = 0) and `1` (common flow, Σ s·e = 0).
+//!
+//! A junction takes any number of bonds of one dimension. Its *dominant* bond is the one that
+//! decides the common variable: at a 0-junction the bond that brings the effort (the junction
+//! computes its flow), at a 1-junction the bond that brings the flow (the junction computes
+//! its effort). Each junction works in two stages, so that distributing the common variable
+//! and summing the others never form a false algebraic loop. Power is conserved exactly.
+
+use crate::bond::PortCausality;
+use crate::element::{CausalRule, Element, Io, Ports, Slot, Stage};
+
+fn dominant(io: &Io<'_>, c: PortCausality) -> usize {
+    (0..io.n_ports()).find(|&p| io.causality(p) == c).unwrap_or(0)
+}
+
+fn two_stages(causality: &[PortCausality], dominant_c: PortCausality, common: fn(usize) -> Slot, summed: fn(usize) -> Slot) -> Vec<Stage> {
+    let d = causality.iter().position(|&c| c == dominant_c).unwrap_or(0);
+    let others: Vec<usize> = (0..causality.len()).filter(|&p| p != d).collect();
+    vec![
+        Stage { writes: others.iter().map(|&p| common(p)).collect(), reads: vec![common(d)] },
+        Stage { writes: vec![summed(d)], reads: others.iter().map(|&p| summed(p)).collect() },
+    ]
+}
+
+/// 0-junction (common effort, parallel connection, Kirchhoff's current law).
+#[derive(Debug, Default)]
+pub struct ZeroJunction;
+
+impl Element for ZeroJunction {
+    fn kind(&self) -> &str {
+        "0"
+    }
+    fn ports(&self) -> Ports {
+        Ports::Any
+    }
+    fn causal_rule(&self, _: usize) -> CausalRule {
+        CausalRule::ExactlyOne(PortCausality::FlowOut)
+    }
+    fn stages(&self, causality: &[PortCausality]) -> Vec<Stage> {
+        two_stages(causality, PortCausality::FlowOut, Slot::Effort, Slot::Flow)
+    }
+    fn eval(&self, stage: usize, io: &mut Io<'_>) {
+        let d = dominant(io, PortCausality::FlowOut);
+        for k in 0..io.dim(d) {
+            if stage == 0 {
+                let e = io.e(d, k);
+                for p in (0..io.n_ports()).filter(|&p| p != d) {
+                    io.set_e(p, k, e);
+                }
+            } else {
+                let sum: f64 = (0..io.n_ports()).filter(|&p| p != d).map(|p| io.f_in(p, k)).sum();
+                io.set_f_in(d, k, -sum);
+            }
+        }
+    }
+}
+
+/// 1-junction (common flow, series connection, Kirchhoff's voltage law / force balance).
+#[derive(Debug, Default)]
+pub struct OneJunction;
+
+impl Element for OneJunction {
+    fn kind(&self) -> &str {
+        "1"
+    }
+    fn ports(&self) -> Ports {
+        Ports::Any
+    }
+    fn causal_rule(&self, _: usize) -> CausalRule {
+        CausalRule::ExactlyOne(PortCausality::EffortOut)
+    }
+    fn stages(&self, causality: &[PortCausality]) -> Vec<Stage> {
+        two_stages(causality, PortCausality::EffortOut, Slot::Flow, Slot::Effort)
+    }
+    fn eval(&self, stage: usize, io: &mut Io<'_>) {
+        let d = dominant(io, PortCausality::EffortOut);
+        for k in 0..io.dim(d) {
+            if stage == 0 {
+                // The bond variables share one flow whatever the half-arrows say.
+                let f = io.f_in(d, k) * io.sign(d);
+                for p in (0..io.n_ports()).filter(|&p| p != d) {
+                    let s = io.sign(p);
+                    io.set_f_in(p, k, s * f);
+                }
+            } else {
+                let sum: f64 = (0..io.n_ports()).filter(|&p| p != d).map(|p| io.sign(p) * io.e(p, k)).sum();
+                let s = io.sign(d);
+                io.set_e(d, k, -s * sum);
+            }
+        }
+    }
+}

@@ -1,0 +1,68 @@
+//! First-order lag `lag`: τ·dy/dt = u − y (a spool's dynamics, a low-pass filter).
+//!
+//! A signal block: no ports, one state `y`, one input `u`, one output `y` (the state, so
+//! readers never wait for the input). Energy-free bookkeeping, not a storage element.
+
+use crate::bond::PortCausality;
+use crate::element::{CausalRule, Element, Io, Ports, SignalSpec, Stage, StateSpec};
+use crate::error::ParamError;
+
+/// First-order lag with time constant `tau` (s, > 0) reading the signal `input`.
+#[derive(Debug)]
+pub struct Lag {
+    input: String,
+    tau: f64,
+    y0: f64,
+}
+
+impl Lag {
+    /// A lag reading signal `input` with time constant `tau` and initial output `y0`.
+    pub fn new(input: &str, tau: f64, y0: f64) -> Result<Self, ParamError> {
+        ParamError::positive("tau", tau)?;
+        ParamError::finite("y0", y0)?;
+        Ok(Self { input: input.to_owned(), tau, y0 })
+    }
+}
+
+impl Element for Lag {
+    fn kind(&self) -> &str {
+        "lag"
+    }
+    fn ports(&self) -> Ports {
+        Ports::Fixed(Vec::new())
+    }
+    fn causal_rule(&self, _: usize) -> CausalRule {
+        CausalRule::None
+    }
+    fn states(&self) -> Vec<StateSpec> {
+        vec![StateSpec::new("y", self.y0)]
+    }
+    fn signal_inputs(&self) -> Vec<SignalSpec> {
+        vec![SignalSpec::scalar(&self.input)]
+    }
+    fn signal_outputs(&self) -> Vec<SignalSpec> {
+        vec![SignalSpec::scalar("out")]
+    }
+    fn stages(&self, causality: &[PortCausality]) -> Vec<Stage> {
+        Stage::from_states(causality, 0, 1)
+    }
+    fn eval(&self, _: usize, io: &mut Io<'_>) {
+        let y = io.states()[0];
+        io.set_y(0, 0, y);
+    }
+    fn derivatives(&self, io: &Io<'_>, dx: &mut [f64]) {
+        dx[0] = (io.u(0) - io.states()[0]) / self.tau;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rejects_non_positive_time_constant() {
+        assert!(Lag::new("u", 0.0, 0.0).is_err());
+        assert!(Lag::new("u", -0.1, 0.0).is_err());
+        assert!(Lag::new("u", 0.1, f64::NAN).is_err());
+    }
+}

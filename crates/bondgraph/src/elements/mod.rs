@@ -1,0 +1,50 @@
+//! The basic bond-graph elements. One file per element: its law, its causality, its tests.
+//!
+//! | symbol | type | law (power into the element positive) |
+//! |---|---|---|
+//! | `Se` | [`EffortSource`] | e = e_s(t, signals) |
+//! | `Sf` | [`FlowSource`] | f_in = f_s(t, signals) |
+//! | `R` | [`Resistor`] | e = r·f_in |
+//! | `C` | [`Capacitor`] | dq/dt = f_in, e = q/c |
+//! | `I` | [`Inertia`] | dp/dt = e, f_in = p/m |
+//! | `TF`, `MTF` | [`Transformer`] | e₁ = m·e₂, f_in₂ = −m·f_in₁ |
+//! | `MTF` (matrix) | [`MatrixTransformer`] | e₁ = T·e₂, f_in₂ = −Tᵀ·f_in₁ |
+//! | `GY`, `MGY` | [`Gyrator`] | e₁ = −r·f_in₂, e₂ = r·f_in₁ |
+//! | `0` | [`ZeroJunction`] | common effort, Σ f_in = 0 |
+//! | `1` | [`OneJunction`] | common flow, Σ s·e = 0 |
+//! | `lag` | [`Lag`] | τ·dy/dt = u − y |
+//! | `p_control` | [`PController`] | y = clamp(K·(r − u), lo, hi) |
+//! | `signal` | [`SignalFunction`] | y = g(t, signals) |
+
+mod capacitor;
+mod gyrator;
+mod inertia;
+mod junction;
+mod lag;
+mod matrix_transformer;
+mod p_controller;
+mod resistor;
+mod signal_function;
+mod sources;
+mod transformer;
+
+pub use capacitor::Capacitor;
+pub use gyrator::Gyrator;
+pub use inertia::Inertia;
+pub use junction::{OneJunction, ZeroJunction};
+pub use lag::Lag;
+pub use matrix_transformer::MatrixTransformer;
+pub use p_controller::PController;
+pub use resistor::Resistor;
+pub use signal_function::SignalFunction;
+pub use sources::{EffortSource, FlowSource};
+pub use transformer::Transformer;
+
+/// Names for the `n` components of a vector state: `p` for n = 1, else `p[0]`, `p[1]`, …
+pub(crate) fn component_names(base: &str, n: usize) -> Vec<String> {
+    if n == 1 {
+        vec![base.to_owned()]
+    } else {
+        (0..n).map(|k| format!("{base}[{k}]")).collect()
+    }
+}

@@ -1,0 +1,69 @@
+//! Saturated proportional controller `p_control`: y = clamp(K·(r − u), lo, hi).
+//!
+//! The paper's eq. 83 is `x_v = clamp(−K_v·(l − l_d), −1, 1)`: gain K_v, set-point r = l_d,
+//! measured signal u = l. A stateless signal block (one stage).
+
+use crate::element::{CausalRule, Element, Io, Param, Ports, SignalSpec};
+use crate::error::ParamError;
+
+/// P-controller with gain `gain`, set-point `setpoint` (may be modulated) and output limits.
+#[derive(Debug)]
+pub struct PController {
+    measured: String,
+    gain: f64,
+    setpoint: Param,
+    lo: f64,
+    hi: f64,
+}
+
+impl PController {
+    /// A controller reading `measured`; `lo < hi` (infinite limits allowed), finite gain.
+    pub fn new(measured: &str, gain: f64, setpoint: impl Into<Param>, lo: f64, hi: f64) -> Result<Self, ParamError> {
+        ParamError::finite("gain", gain)?;
+        let setpoint = setpoint.into();
+        if let Some(r) = setpoint.constant() {
+            ParamError::finite("setpoint", r)?;
+        }
+        if lo.is_nan() || hi.is_nan() || lo >= hi {
+            return Err(ParamError::Shape { param: "limits".into(), message: format!("need min < max, got [{lo}, {hi}]") });
+        }
+        Ok(Self { measured: measured.to_owned(), gain, setpoint, lo, hi })
+    }
+}
+
+impl Element for PController {
+    fn kind(&self) -> &str {
+        "p_control"
+    }
+    fn ports(&self) -> Ports {
+        Ports::Fixed(Vec::new())
+    }
+    fn causal_rule(&self, _: usize) -> CausalRule {
+        CausalRule::None
+    }
+    fn signal_inputs(&self) -> Vec<SignalSpec> {
+        let mut v = vec![SignalSpec::scalar(&self.measured)];
+        v.extend(self.setpoint.signal_inputs());
+        v
+    }
+    fn signal_outputs(&self) -> Vec<SignalSpec> {
+        vec![SignalSpec::scalar("out")]
+    }
+    fn eval(&self, _: usize, io: &mut Io<'_>) {
+        let r = self.setpoint.value(io, 1);
+        let y = (self.gain * (r - io.u(0))).clamp(self.lo, self.hi);
+        io.set_y(0, 0, y);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rejects_bad_limits() {
+        assert!(PController::new("l", 0.3, 6.0, 1.0, -1.0).is_err());
+        assert!(PController::new("l", f64::NAN, 6.0, -1.0, 1.0).is_err());
+        assert!(PController::new("l", 0.3, 6.0, -1.0, 1.0).is_ok());
+    }
+}

@@ -1,0 +1,78 @@
+//! Sources `Se` and `Sf`: impose an effort or a flow, fixed causality.
+//!
+//! The value may be constant or modulated by time and signals ([`Param`]). On a multibond
+//! every component gets the same value. With power-in positive, a source delivering power
+//! has `e·f_in < 0`; draw its bond pointing away from it.
+
+use crate::bond::PortCausality;
+use crate::element::{CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec};
+
+/// Effort source `Se`: e = e_s(t, signals) on every component.
+#[derive(Debug)]
+pub struct EffortSource {
+    value: Param,
+}
+
+impl EffortSource {
+    /// A source of the given effort.
+    pub fn new(value: impl Into<Param>) -> Self {
+        Self { value: value.into() }
+    }
+}
+
+impl Element for EffortSource {
+    fn kind(&self) -> &str {
+        "Se"
+    }
+    fn ports(&self) -> Ports {
+        Ports::Fixed(vec![PortSpec::any_dim("1")])
+    }
+    fn causal_rule(&self, _: usize) -> CausalRule {
+        CausalRule::Fixed(vec![PortCausality::EffortOut])
+    }
+    fn signal_inputs(&self) -> Vec<SignalSpec> {
+        self.value.signal_inputs()
+    }
+    fn eval(&self, _: usize, io: &mut Io<'_>) {
+        let v = self.value.value(io, 0);
+        for k in 0..io.dim(0) {
+            io.set_e(0, k, v);
+        }
+    }
+}
+
+/// Flow source `Sf`: delivers the flow f_s(t, signals), i.e. f_in = −f_s. With its bond drawn
+/// pointing away from the source (the usual way), the bond's flow is `f_s`.
+#[derive(Debug)]
+pub struct FlowSource {
+    value: Param,
+}
+
+impl FlowSource {
+    /// A source delivering the given flow along its outgoing bond.
+    pub fn new(value: impl Into<Param>) -> Self {
+        Self { value: value.into() }
+    }
+}
+
+impl Element for FlowSource {
+    fn kind(&self) -> &str {
+        "Sf"
+    }
+    fn ports(&self) -> Ports {
+        Ports::Fixed(vec![PortSpec::any_dim("1")])
+    }
+    fn causal_rule(&self, _: usize) -> CausalRule {
+        CausalRule::Fixed(vec![PortCausality::FlowOut])
+    }
+    fn signal_inputs(&self) -> Vec<SignalSpec> {
+        self.value.signal_inputs()
+    }
+    fn eval(&self, _: usize, io: &mut Io<'_>) {
+        // The value is the flow *delivered* along the bond: the flow out of the source.
+        let v = self.value.value(io, 0);
+        for k in 0..io.dim(0) {
+            io.set_f_in(0, k, -v);
+        }
+    }
+}

@@ -1,0 +1,83 @@
+//! Transformer `TF` / modulated transformer `MTF`: e₁ = m·e₂, f_in₂ = −m·f_in₁.
+//!
+//! With the usual drawing (bond 1 into the TF, bond 2 out of it) this is the textbook
+//! e₁ = m·e₂, f₂ = m·f₁. Power is conserved: e₁·f_in₁ + e₂·f_in₂ = 0. The modulus may depend
+//! on time and signals (MTF). Causality: exactly one port sets its effort; the inverse
+//! orientation (e₂ = e₁/m, f_in₁ = −f_in₂/m) needs m ≠ 0. Multibonds: component-wise.
+
+use crate::bond::PortCausality;
+use crate::element::{CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Slot, Stage};
+use crate::error::ParamError;
+
+/// Transformer with (possibly modulated) modulus `m` (dimensionless or with units e₁/e₂).
+#[derive(Debug)]
+pub struct Transformer {
+    m: Param,
+}
+
+impl Transformer {
+    /// A transformer; a constant `m` must be finite and non-zero.
+    pub fn new(m: impl Into<Param>) -> Result<Self, ParamError> {
+        let m = m.into();
+        if let Some(v) = m.constant() {
+            ParamError::non_zero("m", v)?;
+        }
+        Ok(Self { m })
+    }
+}
+
+impl Element for Transformer {
+    fn kind(&self) -> &str {
+        match self.m {
+            Param::Const(_) => "TF",
+            Param::Modulated { .. } => "MTF",
+        }
+    }
+    fn ports(&self) -> Ports {
+        Ports::Fixed(vec![PortSpec::any_dim("1"), PortSpec::any_dim("2")])
+    }
+    fn causal_rule(&self, _: usize) -> CausalRule {
+        CausalRule::ExactlyOne(PortCausality::EffortOut)
+    }
+    fn signal_inputs(&self) -> Vec<SignalSpec> {
+        self.m.signal_inputs()
+    }
+    fn stages(&self, causality: &[PortCausality]) -> Vec<Stage> {
+        // Effort travels from the FlowOut side to the EffortOut side, flow the other way.
+        let (out, inp) = if causality[0] == PortCausality::EffortOut { (0, 1) } else { (1, 0) };
+        let mut modulation: Vec<Slot> = (0..self.m.n_inputs()).map(Slot::Input).collect();
+        let mut effort = vec![Slot::Effort(inp)];
+        effort.append(&mut modulation.clone());
+        let mut flow = vec![Slot::Flow(out)];
+        flow.append(&mut modulation);
+        vec![
+            Stage { writes: vec![Slot::Effort(out)], reads: effort },
+            Stage { writes: vec![Slot::Flow(inp)], reads: flow },
+        ]
+    }
+    fn eval(&self, stage: usize, io: &mut Io<'_>) {
+        let m = self.m.value(io, 0);
+        let forward = io.causality(0) == PortCausality::EffortOut;
+        for k in 0..io.dim(0) {
+            match (stage, forward) {
+                (0, true) => io.set_e(0, k, m * io.e(1, k)),
+                (1, true) => io.set_f_in(1, k, -m * io.f_in(0, k)),
+                (0, false) => io.set_e(1, k, io.e(0, k) / m),
+                _ => io.set_f_in(0, k, -io.f_in(1, k) / m),
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rejects_zero_modulus() {
+        assert!(Transformer::new(0.0).is_err());
+        assert!(Transformer::new(f64::NAN).is_err());
+        assert_eq!(Transformer::new(2.0).unwrap().kind(), "TF");
+        assert_eq!(Transformer::new(Param::modulated(vec!["t".into()], |t, _| t)).unwrap().kind(), "MTF");
+    }
+}

@@ -1,0 +1,492 @@
+//! Simulation: [`StateEquations`] → [`Trajectory`] with diffsol's stiff solvers.
+//!
+//! * Methods: BDF (variable order 1–5, the default), ESDIRK34, TR-BDF2 (implicit), Tsit45
+//!   (explicit, for non-stiff checks).
+//! * The implicit methods need Jacobian–vector products. We form them by forward finite
+//!   differences, `Jv ≈ (f(x + σv) − f(x))/σ` with `σ = √ε·max(|x_j|, nominal_j)/‖v‖∞`,
+//!   caching `f(x)` between the n products that make up one dense Jacobian: a Jacobian costs
+//!   n + 1 right-hand-side evaluations. diffsol re-evaluates it rarely (every ~20 steps or on
+//!   a convergence failure), so for our sizes this is a small share of the run time.
+//! * Results are written at the output times `t0, t0 + Δ, …, t_end` by the solver's dense
+//!   interpolation; the solver steps onto every scheduled event time exactly, the event
+//!   replaces elements (a parameter switch), and the solver restarts from there. The output
+//!   row at an event time is computed after the switch.
+//! * After every accepted step the state is checked: a NaN or infinity stops the run with the
+//!   time, the state and its element named, and keeps the rows computed so far. A solver
+//!   failure does the same.
+
+use std::cell::{Cell, RefCell};
+use std::time::{Duration, Instant};
+
+use diffsol::{NalgebraLU, NalgebraMat, OdeBuilder, OdeEquations, OdeSolverMethod, OdeSolverStopReason, Op};
+
+use crate::bond::ElementId;
+use crate::element::Element;
+use crate::equations::{Probe, StateEquations};
+use crate::error::SimulationError;
+
+type M = NalgebraMat<f64>;
+type LS = NalgebraLU<f64>;
+
+/// Integration method.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Method {
+    /// Variable-order BDF (NDF), orders 1–5: the default for stiff systems.
+    #[default]
+    Bdf,
+    /// Explicit-first-stage singly diagonally implicit Runge–Kutta, order 3 (4 stages).
+    Esdirk34,
+    /// TR-BDF2, order 2.
+    TrBdf2,
+    /// Tsitouras 5(4), explicit: only for non-stiff models.
+    Tsit45,
+}
+
+impl Method {
+    /// Parse `bdf`, `esdirk34`, `tr-bdf2`, `tsit45`.
+    #[must_use]
+    pub fn parse(s: &str) -> Option<Self> {
+        match s.to_ascii_lowercase().replace('_', "-").as_str() {
+            "bdf" => Some(Self::Bdf),
+            "esdirk34" | "esdirk" => Some(Self::Esdirk34),
+            "tr-bdf2" | "trbdf2" => Some(Self::TrBdf2),
+            "tsit45" | "tsit5" => Some(Self::Tsit45),
+            _ => None,
+        }
+    }
+    /// The name `parse` accepts.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Bdf => "bdf",
+            Self::Esdirk34 => "esdirk34",
+            Self::TrBdf2 => "tr-bdf2",
+            Self::Tsit45 => "tsit45",
+        }
+    }
+    /// All methods.
+    pub const ALL: [Method; 4] = [Method::Bdf, Method::Esdirk34, Method::TrBdf2, Method::Tsit45];
+}
+
+/// Simulation settings.
+#[derive(Clone, Debug)]
+pub struct Settings {
+    /// Start time (s).
+    pub t_start: f64,
+    /// End time (s).
+    pub t_end: f64,
+    /// Output interval (s).
+    pub dt_out: f64,
+    /// Method.
+    pub method: Method,
+    /// Relative tolerance.
+    pub rtol: f64,
+    /// Absolute tolerance, scaled per state by its nominal magnitude.
+    pub atol: f64,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self { t_start: 0.0, t_end: 1.0, dt_out: 0.01, method: Method::Bdf, rtol: 1e-6, atol: 1e-8 }
+    }
+}
+
+impl Settings {
+    /// Check the settings make sense.
+    pub fn validate(&self) -> Result<(), SimulationError> {
+        let bad = |m: String| Err(SimulationError::Settings(m));
+        if !self.t_start.is_finite() || !self.t_end.is_finite() || self.t_end <= self.t_start {
+            return bad(format!("need finite t_start < t_end, got t_start = {}, t_end = {}", self.t_start, self.t_end));
+        }
+        if !(self.dt_out.is_finite() && self.dt_out > 0.0) {
+            return bad(format!("dt_out must be finite and > 0, got {}", self.dt_out));
+        }
+        if (self.t_end - self.t_start) / self.dt_out > 1e8 {
+            return bad(format!("dt_out = {} gives more than 1e8 output rows", self.dt_out));
+        }
+        if !(self.rtol.is_finite() && self.rtol > 0.0 && self.rtol < 1.0) {
+            return bad(format!("rtol must be in (0, 1), got {}", self.rtol));
+        }
+        if !(self.atol.is_finite() && self.atol > 0.0) {
+            return bad(format!("atol must be finite and > 0, got {}", self.atol));
+        }
+        Ok(())
+    }
+}
+
+/// A scheduled event: at time `t`, replace elements (switch parameters).
+#[derive(Debug)]
+pub struct Event {
+    /// Time (s).
+    pub t: f64,
+    /// Replacement elements, each of the same shape as the one it replaces.
+    pub replacements: Vec<(ElementId, Box<dyn Element>)>,
+}
+
+/// Solver work, summed over all segments between events.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Statistics {
+    /// Accepted steps.
+    pub steps: usize,
+    /// Right-hand-side evaluations requested by the solver.
+    pub rhs_evals: usize,
+    /// Right-hand-side evaluations spent in finite-difference Jacobian–vector products.
+    pub jac_rhs_evals: usize,
+    /// Jacobian evaluations (each costs n + 1 rhs evaluations).
+    pub jac_evals: usize,
+    /// LU factorisations.
+    pub lu_factorisations: usize,
+    /// Rejected steps (local error test failures).
+    pub error_test_failures: usize,
+    /// Newton iterations.
+    pub newton_iterations: usize,
+    /// Newton convergence failures.
+    pub newton_failures: usize,
+    /// Scheduled events applied.
+    pub events: usize,
+    /// Wall time of the integration.
+    pub wall_time: Duration,
+}
+
+impl std::fmt::Display for Statistics {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "steps {}, rhs evals {} (+{} for Jacobians), Jacobian evals {}, LU factorisations {}, error-test failures {}, Newton iterations {}, Newton failures {}, events {}, wall time {:.3} s",
+            self.steps,
+            self.rhs_evals,
+            self.jac_rhs_evals,
+            self.jac_evals,
+            self.lu_factorisations,
+            self.error_test_failures,
+            self.newton_iterations,
+            self.newton_failures,
+            self.events,
+            self.wall_time.as_secs_f64()
+        )
+    }
+}
+
+/// Results: one row per output time, first column `t`.
+#[derive(Clone, Debug, Default)]
+pub struct Trajectory {
+    /// Column names, `t` first.
+    pub columns: Vec<String>,
+    /// Rows of values.
+    pub rows: Vec<Vec<f64>>,
+}
+
+impl Trajectory {
+    /// The column called `name`.
+    #[must_use]
+    pub fn column(&self, name: &str) -> Option<Vec<f64>> {
+        let j = self.columns.iter().position(|c| c == name)?;
+        Some(self.rows.iter().map(|r| r[j]).collect())
+    }
+}
+
+/// What a run produced: the rows so far, the statistics, and the error that stopped it, if any.
+#[derive(Debug)]
+pub struct Outcome {
+    /// Output rows computed.
+    pub trajectory: Trajectory,
+    /// Solver work.
+    pub stats: Statistics,
+    /// Time reached.
+    pub t_final: f64,
+    /// State reached.
+    pub x_final: Vec<f64>,
+    /// Why the run stopped early, if it did.
+    pub error: Option<SimulationError>,
+}
+
+/// A named output column.
+#[derive(Clone, Debug)]
+pub struct Output {
+    /// Column name.
+    pub name: String,
+    /// What it reads.
+    pub probe: Probe,
+}
+
+struct Recorder<'e> {
+    eqs: &'e StateEquations,
+    outputs: &'e [Output],
+    grid: Vec<f64>,
+    next: usize,
+    rows: Vec<Vec<f64>>,
+}
+
+impl Recorder<'_> {
+    fn record(&mut self, t: f64, x: &[f64]) {
+        self.eqs.evaluate(t, x);
+        let mut row = Vec::with_capacity(self.outputs.len() + 1);
+        row.push(t);
+        row.extend(self.outputs.iter().map(|o| self.eqs.read(o.probe, t, x)));
+        self.rows.push(row);
+        self.next += 1;
+    }
+    fn pending(&self) -> Option<f64> {
+        self.grid.get(self.next).copied()
+    }
+}
+
+fn same_time(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-10 * (1.0 + a.abs().max(b.abs()))
+}
+
+/// Run a simulation.
+///
+/// # Arguments
+/// * `eqs` — the equations; scheduled events replace elements in it (they stay replaced).
+/// * `x0` — initial state (use [`StateEquations::initial_state`]).
+/// * `settings`, `outputs` — solver settings and the columns to record besides `t`.
+/// * `events` — scheduled parameter switches, applied at their times (events at or before
+///   `t_start` are applied before the run).
+///
+/// # Returns
+/// An [`Outcome`] that always carries the rows computed, even when the run failed.
+pub fn simulate(eqs: &mut StateEquations, x0: &[f64], settings: &Settings, outputs: &[Output], mut events: Vec<Event>) -> Outcome {
+    let columns = std::iter::once("t".to_owned()).chain(outputs.iter().map(|o| o.name.clone())).collect();
+    let mut out = Outcome {
+        trajectory: Trajectory { columns, rows: Vec::new() },
+        stats: Statistics::default(),
+        t_final: settings.t_start,
+        x_final: x0.to_vec(),
+        error: None,
+    };
+    if let Err(e) = settings.validate() {
+        out.error = Some(e);
+        return out;
+    }
+    if x0.len() != eqs.n_states() {
+        out.error = Some(SimulationError::Settings(format!("initial state has {} values, the model {} states", x0.len(), eqs.n_states())));
+        return out;
+    }
+    if let Some((i, v)) = x0.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        let s = &eqs.states()[i];
+        out.error = Some(SimulationError::NonFinite {
+            t: settings.t_start,
+            state: s.name.clone(),
+            element: eqs.graph().node(s.element).name.clone(),
+            value: *v,
+            culprit: " (initial value)".into(),
+        });
+        return out;
+    }
+    let start = Instant::now();
+    events.sort_by(|a, b| a.t.total_cmp(&b.t));
+    let (t0, t_end) = (settings.t_start, settings.t_end);
+    let n_out = ((t_end - t0) / settings.dt_out + 1e-9).floor() as usize;
+    let mut grid: Vec<f64> = (0..=n_out).map(|k| t0 + k as f64 * settings.dt_out).collect();
+    if grid.last().is_some_and(|&t| !same_time(t, t_end)) {
+        grid.push(t_end);
+    }
+    let mut x = x0.to_vec();
+    let mut t = t0;
+    let mut events = events.into_iter().peekable();
+    let mut rows = Vec::new();
+    loop {
+        // Apply every event due now.
+        while let Some(ev) = events.next_if(|e| e.t <= t || same_time(e.t, t)) {
+            for (id, el) in ev.replacements {
+                if let Err(source) = eqs.replace(id, el) {
+                    out.error = Some(SimulationError::Event { t: ev.t, source });
+                }
+            }
+            out.stats.events += 1;
+        }
+        if out.error.is_some() {
+            break;
+        }
+        let mut rec = Recorder { eqs, outputs, grid: std::mem::take(&mut grid), next: 0, rows: std::mem::take(&mut rows) };
+        // Rows due at the current time (after the events).
+        rec.next = rec.grid.iter().position(|&g| g > t && !same_time(g, t)).unwrap_or(rec.grid.len());
+        if rec.rows.len() < rec.next {
+            rec.record(t, &x);
+        }
+        let t_stop = events.peek().map_or(t_end, |e| e.t.min(t_end));
+        if t >= t_end || same_time(t, t_end) {
+            rows = rec.rows;
+            break;
+        }
+        let seg = run_segment(&mut rec, settings, t, t_stop, &x, &mut out.stats);
+        grid = rec.grid;
+        rows = rec.rows;
+        match seg {
+            Ok(xs) => {
+                x = xs;
+                t = t_stop;
+            }
+            Err((te, xe, err)) => {
+                t = te;
+                x = xe;
+                out.error = Some(err);
+                break;
+            }
+        }
+    }
+    out.trajectory.rows = rows;
+    out.t_final = t;
+    out.x_final = x;
+    out.stats.wall_time = start.elapsed();
+    out
+}
+
+type SegmentError = (f64, Vec<f64>, SimulationError);
+
+/// Integrate from `t` to `t_stop`, recording grid rows strictly before `t_stop`.
+fn run_segment(rec: &mut Recorder<'_>, settings: &Settings, t: f64, t_stop: f64, x: &[f64], stats: &mut Statistics) -> Result<Vec<f64>, SegmentError> {
+    let eqs = rec.eqs;
+    let n = x.len();
+    let nominal: Vec<f64> = eqs.states().iter().map(|s| s.nominal).collect();
+    let atol: Vec<f64> = nominal.iter().map(|s| settings.atol * s).collect();
+    let rhs_calls = Cell::new(0usize);
+    let jac_calls = Cell::new(0usize);
+    let bad: RefCell<Option<(f64, Vec<f64>)>> = RefCell::new(None);
+    let cache = RefCell::new(FdCache { x: vec![f64::NAN; n], t: f64::NAN, fx: vec![0.0; n], xp: vec![0.0; n], fxp: vec![0.0; n] });
+    let rhs = |x: &[f64], _p: &[f64], t: f64, dx: &mut [f64]| {
+        rhs_calls.set(rhs_calls.get() + 1);
+        eqs.rhs(t, x, dx);
+        if bad.borrow().is_none() && dx.iter().any(|v| !v.is_finite()) {
+            *bad.borrow_mut() = Some((t, x.to_vec()));
+        }
+    };
+    let jvp = |x: &[f64], _p: &[f64], t: f64, v: &[f64], jv: &mut [f64]| {
+        let mut c = cache.borrow_mut();
+        let FdCache { x: cx, t: ct, fx, xp, fxp } = &mut *c;
+        if *ct != t || cx.as_slice() != x {
+            eqs.rhs(t, x, fx);
+            jac_calls.set(jac_calls.get() + 1);
+            cx.copy_from_slice(x);
+            *ct = t;
+        }
+        let vmax = v.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+        if vmax == 0.0 || !vmax.is_finite() {
+            jv.iter_mut().for_each(|j| *j = 0.0);
+            return;
+        }
+        let scale = x.iter().zip(v).zip(&nominal).filter(|((_, vj), _)| **vj != 0.0).fold(0.0f64, |m, ((xj, _), s)| m.max(xj.abs()).max(*s));
+        let sigma = f64::EPSILON.sqrt() * scale / vmax;
+        for k in 0..x.len() {
+            xp[k] = x[k] + sigma * v[k];
+        }
+        eqs.rhs(t, xp, fxp);
+        jac_calls.set(jac_calls.get() + 1);
+        for k in 0..x.len() {
+            jv[k] = (fxp[k] - fx[k]) / sigma;
+        }
+    };
+    let x0 = x.to_vec();
+    let problem = OdeBuilder::<M>::new()
+        .t0(t)
+        .rtol(settings.rtol)
+        .atol(atol)
+        .rhs_implicit(rhs, jvp)
+        .init(move |_p, _t, y| y.copy_from_slice(&x0), n)
+        .build();
+    let mut problem = match problem {
+        Ok(p) => p,
+        Err(e) => return Err((t, x.to_vec(), SimulationError::Settings(format!("{e}")))),
+    };
+    // Recovered Newton failures must not end a long run (diffsol counts them cumulatively);
+    // a real divergence still ends in a step-size failure.
+    problem.ode_options.max_nonlinear_solver_failures = usize::MAX / 2;
+    problem.ode_options.max_error_test_failures = 100;
+    let result = match settings.method {
+        Method::Bdf => problem.bdf::<LS>().map_err(|e| e.to_string()).map(|s| drive(s, rec, t_stop, &bad, stats)),
+        Method::Esdirk34 => problem.esdirk34::<LS>().map_err(|e| e.to_string()).map(|s| drive(s, rec, t_stop, &bad, stats)),
+        Method::TrBdf2 => problem.tr_bdf2::<LS>().map_err(|e| e.to_string()).map(|s| drive(s, rec, t_stop, &bad, stats)),
+        Method::Tsit45 => problem.tsit45().map_err(|e| e.to_string()).map(|s| drive(s, rec, t_stop, &bad, stats)),
+    };
+    stats.rhs_evals += rhs_calls.get();
+    stats.jac_rhs_evals += jac_calls.get();
+    stats.jac_evals += problem.eqn.rhs().statistics().number_of_matrix_evals;
+    match result {
+        Ok(r) => r,
+        Err(message) => Err((t, x.to_vec(), SimulationError::Solver { t, message, culprit: String::new() })),
+    }
+}
+
+struct FdCache {
+    x: Vec<f64>,
+    t: f64,
+    fx: Vec<f64>,
+    xp: Vec<f64>,
+    fxp: Vec<f64>,
+}
+
+fn culprit(eqs: &StateEquations, bad: &RefCell<Option<(f64, Vec<f64>)>>) -> String {
+    bad.borrow()
+        .as_ref()
+        .and_then(|(t, x)| eqs.first_non_finite(*t, x).map(|c| format!("; first non-finite value at t = {t:.9} s: {c}")))
+        .unwrap_or_default()
+}
+
+fn drive<'a, Eqn, S>(mut s: S, rec: &mut Recorder<'_>, t_stop: f64, bad: &RefCell<Option<(f64, Vec<f64>)>>, stats: &mut Statistics) -> Result<Vec<f64>, SegmentError>
+where
+    Eqn: OdeEquations<T = f64, V = diffsol::NalgebraVec<f64>> + 'a,
+    S: OdeSolverMethod<'a, Eqn>,
+{
+    let eqs = rec.eqs;
+    let finish = |s: &S, stats: &mut Statistics| {
+        let st = s.get_statistics();
+        stats.steps += st.number_of_steps;
+        stats.error_test_failures += st.number_of_error_test_failures;
+        stats.newton_iterations += st.number_of_nonlinear_solver_iterations;
+        stats.newton_failures += st.number_of_nonlinear_solver_fails;
+        stats.lu_factorisations += st.number_of_linear_solver_setups;
+    };
+    let state_of = |s: &S| -> (f64, Vec<f64>) {
+        let st = s.state();
+        (st.t, st.y.batch_as_slice(0).to_vec())
+    };
+    if let Err(e) = s.set_stop_time(t_stop) {
+        let (t, x) = state_of(&s);
+        return Err((t, x, SimulationError::Solver { t, message: e.to_string(), culprit: String::new() }));
+    }
+    loop {
+        let step = s.step();
+        let (t, x) = state_of(&s);
+        match step {
+            Err(e) => {
+                finish(&s, stats);
+                return Err((t, x, SimulationError::Solver { t, message: e.to_string(), culprit: culprit(eqs, bad) }));
+            }
+            Ok(reason) => {
+                if let Some(i) = x.iter().position(|v| !v.is_finite()) {
+                    finish(&s, stats);
+                    let info = &eqs.states()[i];
+                    let err = SimulationError::NonFinite {
+                        t,
+                        state: info.name.clone(),
+                        element: eqs.graph().node(info.element).name.clone(),
+                        value: x[i],
+                        culprit: culprit(eqs, bad),
+                    };
+                    return Err((t, x, err));
+                }
+                while let Some(tg) = rec.pending() {
+                    if tg > t || same_time(tg, t_stop) || tg > t_stop {
+                        break;
+                    }
+                    if same_time(tg, t) {
+                        rec.record(tg, &x);
+                    } else {
+                        match s.interpolate(tg) {
+                            Ok(y) => rec.record(tg, y.batch_as_slice(0)),
+                            Err(e) => {
+                                finish(&s, stats);
+                                return Err((t, x, SimulationError::Solver { t, message: format!("interpolation at t = {tg}: {e}"), culprit: String::new() }));
+                            }
+                        }
+                    }
+                }
+                if matches!(reason, OdeSolverStopReason::TstopReached) {
+                    finish(&s, stats);
+                    return Ok(x);
+                }
+            }
+        }
+    }
+}
