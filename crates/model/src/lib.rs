@@ -1,1 +1,48 @@
-//! placeholder
+//! # bg-model: bond-graph models in TOML
+//!
+//! A model file reads like the diagram it describes:
+//!
+//! ```toml
+//! title = "Mass–spring–damper"
+//! [parameters]
+//! m = 1.0
+//! k = 100.0
+//! [elements]
+//! mass   = { kind = "I", m = "m" }
+//! spring = { kind = "C", k = "k", q0 = 0.01 }
+//! damper = { kind = "R", r = 0.4 }
+//! v      = { kind = "1" }
+//! [bonds]
+//! b1 = "v -> mass"
+//! b2 = "v -> spring"
+//! b3 = "v -> damper"
+//! [simulation]
+//! t_end = 10.0
+//! ```
+//!
+//! `docs/model-format.md` documents the format.
+//!
+//! ## Loading
+//! [`Model::load`] parses, applies `--set` overrides ([`overrides::apply`]), builds every
+//! element through the [`Registry`], assigns causality and assembles the equations. Every
+//! failure is a [`ModelError`] with file, line, column, element and hint.
+//! [`inspect`] goes as far as it can and reports what it found (`bg-sim check`).
+//!
+//! ## Element kinds
+//! [`Registry::with_core`] knows the core kinds (see [`builtin`]); domain crates register
+//! theirs with [`Registry::register`] and read parameters through [`ElementSpec`].
+//!
+//! ## Expressions
+//! Parameters and element values may be expressions ([`expr`]): `"pi/4*d^2"`, `"1/k"`, or,
+//! where an element allows modulation, functions of signals and time: `"1 + 0.1*spring.q"`.
+
+pub mod builtin;
+pub mod error;
+pub mod expr;
+pub mod load;
+pub mod overrides;
+pub mod registry;
+
+pub use error::{ErrorKind, ModelError};
+pub use load::{inspect, Check, CheckResult, Inspection, Model};
+pub use registry::{BuildFn, ElementSpec, KindInfo, RawValue, Registry};

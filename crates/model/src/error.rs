@@ -1,0 +1,103 @@
+//! [`ModelError`]: every problem in a model file, with the file, line and column, the element
+//! concerned and a hint.
+
+use std::fmt;
+
+/// What kind of problem a [`ModelError`] reports.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum ErrorKind {
+    /// The file cannot be read.
+    Io,
+    /// The TOML does not parse, or has the wrong shape.
+    Syntax,
+    /// A `--set` override cannot be applied.
+    Override,
+    /// An element kind nobody registered.
+    UnknownKind,
+    /// A bond or event names an element that does not exist.
+    UnknownElement,
+    /// A required parameter is missing.
+    MissingParameter,
+    /// A parameter the element does not take.
+    ExtraParameter,
+    /// A parameter value is invalid (negative mass, non-finite number, bad expression, …).
+    BadParameter,
+    /// The graph's structure is wrong (ports, dimensions, signals).
+    Graph,
+    /// Causality assignment or equation ordering failed.
+    Causality,
+    /// Simulation settings, events or outputs are wrong.
+    Settings,
+}
+
+/// A problem in a model file.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ModelError {
+    /// What kind of problem.
+    pub kind: ErrorKind,
+    /// The model file.
+    pub file: String,
+    /// 1-based line, where the TOML gives one.
+    pub line: Option<usize>,
+    /// 1-based column.
+    pub col: Option<usize>,
+    /// The element concerned, if any.
+    pub element: Option<String>,
+    /// What is wrong.
+    pub message: String,
+    /// What to do about it.
+    pub hint: Option<String>,
+}
+
+impl ModelError {
+    pub(crate) fn new(kind: ErrorKind, file: &str, message: impl Into<String>) -> Self {
+        Self { kind, file: file.to_owned(), line: None, col: None, element: None, message: message.into(), hint: None }
+    }
+    pub(crate) fn at(mut self, pos: Option<(usize, usize)>) -> Self {
+        if let Some((l, c)) = pos {
+            self.line = Some(l);
+            self.col = Some(c);
+        }
+        self
+    }
+    pub(crate) fn element(mut self, name: &str) -> Self {
+        self.element = Some(name.to_owned());
+        self
+    }
+    pub(crate) fn hint(mut self, hint: impl Into<String>) -> Self {
+        self.hint = Some(hint.into());
+        self
+    }
+}
+
+impl fmt::Display for ModelError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.file)?;
+        if let Some(l) = self.line {
+            write!(f, ":{l}")?;
+            if let Some(c) = self.col {
+                write!(f, ":{c}")?;
+            }
+        }
+        write!(f, ": ")?;
+        if let Some(e) = &self.element {
+            write!(f, "element `{e}`: ")?;
+        }
+        write!(f, "{}", self.message)?;
+        if let Some(h) = &self.hint {
+            write!(f, "\n  hint: {h}")?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for ModelError {}
+
+/// Line and column (1-based) of byte `offset` in `text`.
+pub(crate) fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let col = before.rfind('\n').map_or(before.chars().count(), |i| before[i + 1..].chars().count()) + 1;
+    (line, col)
+}

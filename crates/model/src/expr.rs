@@ -1,0 +1,450 @@
+//! Arithmetic expressions in model files: `"pi/4*d^2"`, `"1/k"`, `"0.5 + 0.1*spring.q"`.
+//!
+//! Numbers, named parameters, signals (dotted names such as `spring.q`, and `t`), the
+//! operators `+ - * / ^` (`^` binds tightest and to the right; `-2^2` is −4), parentheses and
+//! the functions listed in [`FUNCTIONS`]. Always floating point: `1/2` is 0.5.
+
+use std::fmt;
+
+/// Functions an expression may call, with their number of arguments (`None`: one or more).
+pub const FUNCTIONS: &[(&str, Option<usize>)] = &[
+    ("sqrt", Some(1)),
+    ("exp", Some(1)),
+    ("ln", Some(1)),
+    ("log10", Some(1)),
+    ("sin", Some(1)),
+    ("cos", Some(1)),
+    ("tan", Some(1)),
+    ("asin", Some(1)),
+    ("acos", Some(1)),
+    ("atan", Some(1)),
+    ("atan2", Some(2)),
+    ("sinh", Some(1)),
+    ("cosh", Some(1)),
+    ("tanh", Some(1)),
+    ("abs", Some(1)),
+    ("sign", Some(1)),
+    ("step", Some(1)),
+    ("pow", Some(2)),
+    ("min", None),
+    ("max", None),
+    ("clamp", Some(3)),
+    ("deg", Some(1)),
+    ("rad", Some(1)),
+];
+
+/// Names that are not parameters: `pi` and `t` (time).
+pub const RESERVED: &[&str] = &["pi", "t", "time"];
+
+/// A parse error at a character position of the expression.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ExprError {
+    /// 0-based character position.
+    pub pos: usize,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl fmt::Display for ExprError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} (at character {})", self.message, self.pos + 1)
+    }
+}
+
+/// A parsed expression; identifiers are still names.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Expr {
+    /// A number.
+    Num(f64),
+    /// A name: a parameter, a signal, `t` or `pi`.
+    Name(String),
+    /// Unary minus.
+    Neg(Box<Expr>),
+    /// Binary operation.
+    Bin(char, Box<Expr>, Box<Expr>),
+    /// Function call.
+    Call(String, Vec<Expr>),
+}
+
+impl Expr {
+    /// Parse `src`.
+    pub fn parse(src: &str) -> Result<Self, ExprError> {
+        let chars: Vec<char> = src.chars().collect();
+        let mut p = Parser { c: &chars, i: 0 };
+        let e = p.sum()?;
+        p.ws();
+        if p.i < chars.len() {
+            return Err(p.err(format!("unexpected `{}`", chars[p.i])));
+        }
+        Ok(e)
+    }
+
+    /// Every name used, in order of first appearance.
+    #[must_use]
+    pub fn names(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        self.collect(&mut out);
+        out
+    }
+
+    fn collect(&self, out: &mut Vec<String>) {
+        match self {
+            Self::Num(_) => {}
+            Self::Name(n) => {
+                if !out.contains(n) {
+                    out.push(n.clone());
+                }
+            }
+            Self::Neg(a) => a.collect(out),
+            Self::Bin(_, a, b) => {
+                a.collect(out);
+                b.collect(out);
+            }
+            Self::Call(_, args) => args.iter().for_each(|a| a.collect(out)),
+        }
+    }
+
+    /// Evaluate, looking names up with `lookup` (`pi` is built in).
+    pub fn eval(&self, lookup: &dyn Fn(&str) -> Option<f64>) -> Result<f64, String> {
+        Ok(match self {
+            Self::Num(v) => *v,
+            Self::Name(n) if n == "pi" => std::f64::consts::PI,
+            Self::Name(n) => lookup(n).ok_or_else(|| format!("unknown name `{n}`"))?,
+            Self::Neg(a) => -a.eval(lookup)?,
+            Self::Bin(op, a, b) => {
+                let (a, b) = (a.eval(lookup)?, b.eval(lookup)?);
+                binary(*op, a, b)
+            }
+            Self::Call(f, args) => {
+                let v: Result<Vec<f64>, String> = args.iter().map(|a| a.eval(lookup)).collect();
+                call(f, &v?)
+            }
+        })
+    }
+
+    /// Compile for fast repeated evaluation: every name becomes a constant (via `constant`) or
+    /// an input slot (in the order of `inputs`).
+    pub fn compile(&self, constant: &dyn Fn(&str) -> Option<f64>, inputs: &[String]) -> Result<Compiled, String> {
+        Ok(Compiled(self.lower(constant, inputs)?))
+    }
+
+    fn lower(&self, constant: &dyn Fn(&str) -> Option<f64>, inputs: &[String]) -> Result<Node, String> {
+        Ok(match self {
+            Self::Num(v) => Node::Num(*v),
+            Self::Name(n) if n == "pi" => Node::Num(std::f64::consts::PI),
+            Self::Name(n) => {
+                if let Some(v) = constant(n) {
+                    Node::Num(v)
+                } else if let Some(i) = inputs.iter().position(|x| x == n) {
+                    Node::Input(i)
+                } else {
+                    return Err(format!("unknown name `{n}`"));
+                }
+            }
+            Self::Neg(a) => Node::Neg(Box::new(a.lower(constant, inputs)?)),
+            Self::Bin(op, a, b) => Node::Bin(*op, Box::new(a.lower(constant, inputs)?), Box::new(b.lower(constant, inputs)?)),
+            Self::Call(f, args) => {
+                Node::Call(f.clone(), args.iter().map(|a| a.lower(constant, inputs)).collect::<Result<_, _>>()?)
+            }
+        })
+    }
+}
+
+fn binary(op: char, a: f64, b: f64) -> f64 {
+    match op {
+        '+' => a + b,
+        '-' => a - b,
+        '*' => a * b,
+        '/' => a / b,
+        _ => a.powf(b),
+    }
+}
+
+fn call(f: &str, v: &[f64]) -> f64 {
+    match f {
+        "sqrt" => v[0].sqrt(),
+        "exp" => v[0].exp(),
+        "ln" => v[0].ln(),
+        "log10" => v[0].log10(),
+        "sin" => v[0].sin(),
+        "cos" => v[0].cos(),
+        "tan" => v[0].tan(),
+        "asin" => v[0].asin(),
+        "acos" => v[0].acos(),
+        "atan" => v[0].atan(),
+        "atan2" => v[0].atan2(v[1]),
+        "sinh" => v[0].sinh(),
+        "cosh" => v[0].cosh(),
+        "tanh" => v[0].tanh(),
+        "abs" => v[0].abs(),
+        "sign" => {
+            if v[0] > 0.0 {
+                1.0
+            } else if v[0] < 0.0 {
+                -1.0
+            } else {
+                0.0
+            }
+        }
+        "step" => {
+            if v[0] >= 0.0 {
+                1.0
+            } else {
+                0.0
+            }
+        }
+        "pow" => v[0].powf(v[1]),
+        "min" => v.iter().copied().fold(f64::INFINITY, f64::min),
+        "max" => v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        "clamp" => v[0].max(v[1]).min(v[2]),
+        "deg" => v[0].to_degrees(),
+        "rad" => v[0].to_radians(),
+        _ => f64::NAN,
+    }
+}
+
+#[derive(Clone, Debug)]
+enum Node {
+    Num(f64),
+    Input(usize),
+    Neg(Box<Node>),
+    Bin(char, Box<Node>, Box<Node>),
+    Call(String, Vec<Node>),
+}
+
+/// A compiled expression: constants folded in, signals read from an input slice.
+#[derive(Clone, Debug)]
+pub struct Compiled(Node);
+
+impl Compiled {
+    /// Evaluate with the inputs in the order given to [`Expr::compile`].
+    #[must_use]
+    pub fn eval(&self, inputs: &[f64]) -> f64 {
+        eval_node(&self.0, inputs)
+    }
+    /// The value if the expression has no inputs.
+    #[must_use]
+    pub fn constant(&self) -> Option<f64> {
+        match &self.0 {
+            Node::Num(v) => Some(*v),
+            _ => None,
+        }
+    }
+}
+
+fn eval_node(n: &Node, u: &[f64]) -> f64 {
+    match n {
+        Node::Num(v) => *v,
+        Node::Input(i) => u[*i],
+        Node::Neg(a) => -eval_node(a, u),
+        Node::Bin(op, a, b) => binary(*op, eval_node(a, u), eval_node(b, u)),
+        Node::Call(f, args) => {
+            let mut buf = [0.0; 8];
+            let n = args.len().min(8);
+            for (k, a) in args.iter().take(n).enumerate() {
+                buf[k] = eval_node(a, u);
+            }
+            call(f, &buf[..n])
+        }
+    }
+}
+
+struct Parser<'a> {
+    c: &'a [char],
+    i: usize,
+}
+
+impl Parser<'_> {
+    fn err(&self, message: String) -> ExprError {
+        ExprError { pos: self.i, message }
+    }
+    fn ws(&mut self) {
+        while self.i < self.c.len() && self.c[self.i].is_whitespace() {
+            self.i += 1;
+        }
+    }
+    fn peek(&mut self) -> Option<char> {
+        self.ws();
+        self.c.get(self.i).copied()
+    }
+    fn sum(&mut self) -> Result<Expr, ExprError> {
+        let mut a = self.product()?;
+        while let Some(op @ ('+' | '-')) = self.peek() {
+            self.i += 1;
+            let b = self.product()?;
+            a = Expr::Bin(op, Box::new(a), Box::new(b));
+        }
+        Ok(a)
+    }
+    fn product(&mut self) -> Result<Expr, ExprError> {
+        let mut a = self.unary()?;
+        while let Some(op @ ('*' | '/')) = self.peek() {
+            self.i += 1;
+            let b = self.unary()?;
+            a = Expr::Bin(op, Box::new(a), Box::new(b));
+        }
+        Ok(a)
+    }
+    fn unary(&mut self) -> Result<Expr, ExprError> {
+        match self.peek() {
+            Some('-') => {
+                self.i += 1;
+                Ok(Expr::Neg(Box::new(self.unary()?)))
+            }
+            Some('+') => {
+                self.i += 1;
+                self.unary()
+            }
+            _ => self.power(),
+        }
+    }
+    fn power(&mut self) -> Result<Expr, ExprError> {
+        let base = self.atom()?;
+        if self.peek() == Some('^') {
+            self.i += 1;
+            let exp = self.unary()?;
+            return Ok(Expr::Bin('^', Box::new(base), Box::new(exp)));
+        }
+        Ok(base)
+    }
+    fn atom(&mut self) -> Result<Expr, ExprError> {
+        match self.peek() {
+            None => Err(self.err("expression ends too early".into())),
+            Some('(') => {
+                self.i += 1;
+                let e = self.sum()?;
+                if self.peek() != Some(')') {
+                    return Err(self.err("missing `)`".into()));
+                }
+                self.i += 1;
+                Ok(e)
+            }
+            Some(c) if c.is_ascii_digit() || c == '.' => self.number(),
+            Some(c) if c.is_alphabetic() || c == '_' => self.name(),
+            Some(c) => Err(self.err(format!("unexpected `{c}`"))),
+        }
+    }
+    fn number(&mut self) -> Result<Expr, ExprError> {
+        let start = self.i;
+        while self.i < self.c.len() && (self.c[self.i].is_ascii_digit() || self.c[self.i] == '.' || self.c[self.i] == '_') {
+            self.i += 1;
+        }
+        if self.i < self.c.len() && (self.c[self.i] == 'e' || self.c[self.i] == 'E') {
+            let save = self.i;
+            self.i += 1;
+            if self.i < self.c.len() && (self.c[self.i] == '+' || self.c[self.i] == '-') {
+                self.i += 1;
+            }
+            let digits = self.i;
+            while self.i < self.c.len() && self.c[self.i].is_ascii_digit() {
+                self.i += 1;
+            }
+            if self.i == digits {
+                self.i = save;
+            }
+        }
+        let s: String = self.c[start..self.i].iter().filter(|&&c| c != '_').collect();
+        s.parse().map(Expr::Num).map_err(|_| ExprError { pos: start, message: format!("`{s}` is not a number") })
+    }
+    fn name(&mut self) -> Result<Expr, ExprError> {
+        let start = self.i;
+        while self.i < self.c.len() && (self.c[self.i].is_alphanumeric() || self.c[self.i] == '_' || self.c[self.i] == '.') {
+            self.i += 1;
+        }
+        // an index suffix `[k]`
+        if self.i < self.c.len() && self.c[self.i] == '[' {
+            let save = self.i;
+            self.i += 1;
+            while self.i < self.c.len() && self.c[self.i].is_ascii_digit() {
+                self.i += 1;
+            }
+            if self.i < self.c.len() && self.c[self.i] == ']' {
+                self.i += 1;
+            } else {
+                self.i = save;
+            }
+        }
+        let name: String = self.c[start..self.i].iter().collect();
+        if name.ends_with('.') {
+            return Err(ExprError { pos: start, message: format!("`{name}` is not a valid name") });
+        }
+        if self.peek() == Some('(') {
+            let Some(&(_, arity)) = FUNCTIONS.iter().find(|(f, _)| *f == name) else {
+                let known: Vec<&str> = FUNCTIONS.iter().map(|(f, _)| *f).collect();
+                return Err(ExprError { pos: start, message: format!("unknown function `{name}`; known: {}", known.join(", ")) });
+            };
+            self.i += 1;
+            let mut args = Vec::new();
+            if self.peek() != Some(')') {
+                loop {
+                    args.push(self.sum()?);
+                    match self.peek() {
+                        Some(',') => self.i += 1,
+                        Some(')') => break,
+                        _ => return Err(self.err("expected `,` or `)`".into())),
+                    }
+                }
+            }
+            self.i += 1;
+            let ok = match arity {
+                Some(n) => args.len() == n,
+                None => !args.is_empty() && args.len() <= 8,
+            };
+            if !ok {
+                return Err(ExprError { pos: start, message: format!("`{name}` takes {} argument(s), got {}", arity.map_or("1 to 8".into(), |n| n.to_string()), args.len()) });
+            }
+            return Ok(Expr::Call(name, args));
+        }
+        Ok(Expr::Name(name))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    fn ev(s: &str) -> f64 {
+        Expr::parse(s).unwrap().eval(&|n| (n == "k").then_some(4.0)).unwrap()
+    }
+
+    #[test]
+    fn arithmetic_is_floating_point_with_usual_precedence() {
+        assert!((ev("1/2") - 0.5).abs() < 1e-15);
+        assert!((ev("-2^2") + 4.0).abs() < 1e-15);
+        assert!((ev("2^3^2") - 512.0).abs() < 1e-9);
+        assert!((ev("1 + 2*3 - 4/2") - 5.0).abs() < 1e-15);
+        assert!((ev("pi/4*0.24^2") - 0.045_238_934_211_693_02).abs() < 1e-15);
+        assert!((ev("sqrt(k)*max(1, 2, 3)") - 6.0).abs() < 1e-15);
+        assert!((ev("1.5e3 + 2E-1") - 1500.2).abs() < 1e-12);
+        assert!((ev("clamp(5, -1, 1)") - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn names_include_dotted_signals() {
+        let e = Expr::parse("0.5 + 0.1*spring.q - lever.2.e + arm.q[1]").unwrap();
+        assert_eq!(e.names(), ["spring.q", "lever.2.e", "arm.q[1]"]);
+    }
+
+    #[test]
+    fn errors_point_at_the_problem() {
+        assert_eq!(Expr::parse("1 + ").unwrap_err().pos, 4);
+        assert!(Expr::parse("foo(1)").unwrap_err().message.contains("unknown function"));
+        assert!(Expr::parse("(1 + 2").unwrap_err().message.contains("missing `)`"));
+        assert!(Expr::parse("atan2(1)").unwrap_err().message.contains("takes 2"));
+        assert!(Expr::parse("2 $ 3").is_err());
+    }
+
+    #[test]
+    fn compiled_matches_interpreted() {
+        let e = Expr::parse("k*x + sin(t)").unwrap();
+        let c = e.compile(&|n| (n == "k").then_some(4.0), &["x".into(), "t".into()]).unwrap();
+        let want = e.eval(&|n| match n {
+            "k" => Some(4.0),
+            "x" => Some(0.5),
+            "t" => Some(1.0),
+            _ => None,
+        });
+        assert!((c.eval(&[0.5, 1.0]) - want.unwrap()).abs() < 1e-15);
+    }
+}
