@@ -158,7 +158,7 @@ fn run(path: &Path, output: Option<PathBuf>, solver: Option<&str>, rtol: Option<
         for r in model.verify(&outcome.trajectory) {
             let status = if r.passed { "ok  " } else { "FAIL" };
             if !quiet || !r.passed {
-                println!("check {status} {}: max |error| {:.3e} at t = {} (tolerance {:.1e})", r.column, r.max_error, r.t_worst, r.tol);
+                println!("check {status} {}: max |error| {:.3e} at t = {} (tolerance {:.1e})", r.value, r.max_error, r.t_worst, r.tol);
             }
             if !r.passed {
                 code = ExitCode::from(1);

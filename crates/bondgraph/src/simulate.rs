@@ -301,8 +301,8 @@ pub fn simulate(eqs: &mut StateEquations, x0: &[f64], settings: &Settings, outpu
         }
         let mut rec = Recorder { eqs, outputs, grid: std::mem::take(&mut grid), next: 0, rows: std::mem::take(&mut rows) };
         // Rows due at the current time (after the events).
-        rec.next = rec.grid.iter().position(|&g| g > t && !same_time(g, t)).unwrap_or(rec.grid.len());
-        if rec.rows.len() < rec.next {
+        rec.next = rec.rows.len();
+        while rec.pending().is_some_and(|g| same_time(g, t)) {
             rec.record(t, &x);
         }
         let t_stop = events.peek().map_or(t_end, |e| e.t.min(t_end));

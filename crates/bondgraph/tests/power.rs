@@ -78,7 +78,7 @@ fn power_property(name: &str) {
     assert!(checked >= 1, "{name}: no element carries power at {generic:?}");
 
     let mut runner = TestRunner::new(ProptestConfig { cases: 256, ..ProptestConfig::default() });
-    let strategy = (prop::collection::vec(-1.0f64..1.0, 7), prop_oneof![Just(1e-6), Just(0.5), Just(1.0), Just(1e3)], 0.0f64..10.0);
+    let strategy = (prop::collection::vec(-1.0f64..1.0, 7), prop_oneof![Just(1e-6f64), Just(0.5), Just(1.0), Just(1e3)], 0.0f64..10.0);
     let result = runner.run(&strategy, |(unit, magnitude, t)| {
         // The modulated lever's ratio 1 + q must stay away from 0: keep q within ±0.5.
         let magnitude = if name == "modulated lever" { magnitude.min(0.5) } else { magnitude };

@@ -19,7 +19,7 @@ fn max_abs_diff(a: impl IntoIterator<Item = f64>, b: impl IntoIterator<Item = f6
 /// amplitude (1e-8 absolute) at every output row over 10 s, for every method.
 #[test]
 fn mass_spring_damper_matches_analytic_for_every_method() {
-    let (m, k, r, q0) = (1.0, 100.0, 0.4, 0.01);
+    let (m, k, r, q0): (f64, f64, f64, f64) = (1.0, 100.0, 0.4, 0.01);
     let (alpha, omega0) = (r / (2.0 * m), (k / m).sqrt());
     for method in Method::ALL {
         let mut eqs = mass_spring_damper(m, k, r, q0);
@@ -54,7 +54,7 @@ fn state_index(eqs: &StateEquations, name: &str) -> usize {
 /// y'(0) = 0, so v_C = q/C = V·(1 − e^{−αt}(cos ω_d t + α/ω_d sin ω_d t)).
 #[test]
 fn series_rlc_capacitor_voltage_matches_step_response() {
-    let (v, r, l, c) = (2.0, 1.0, 1.0, 0.25);
+    let (v, r, l, c): (f64, f64, f64, f64) = (2.0, 1.0, 1.0, 0.25);
     let (alpha, omega0) = (r / (2.0 * l), 1.0 / (l * c).sqrt());
     let mut eqs = series_rlc(v, r, l, c);
     let x0 = eqs.initial_state();
@@ -88,7 +88,7 @@ fn series_rlc_capacitor_voltage_matches_step_response() {
 /// energy without damping.
 #[test]
 fn lever_two_masses_oscillate_at_reduced_mass_frequency_and_conserve_energy() {
-    let (n, m1, m2, k, q0) = (2.0, 3.0, 0.5, 40.0, 0.02);
+    let (n, m1, m2, k, q0): (f64, f64, f64, f64, f64) = (2.0, 3.0, 0.5, 40.0, 0.02);
     let m1_reflected = m1 / (n * n);
     let mu = m1_reflected * m2 / (m1_reflected + m2);
     let omega = (k / mu).sqrt();

@@ -44,7 +44,7 @@ fn output_rows_land_on_the_grid_and_end_at_t_end() {
 /// the damped free response restarted from the undamped state at exactly 0.5.
 #[test]
 fn event_replacing_a_resistor_lands_exactly_on_its_time() {
-    let (m, k, q0, r_after, t_ev) = (1.0, 100.0, 0.01, 2.0, 0.5);
+    let (m, k, q0, r_after, t_ev): (f64, f64, f64, f64, f64) = (1.0, 100.0, 0.01, 2.0, 0.5);
     let omega0 = (k / m).sqrt();
     for method in [Method::Bdf, Method::Esdirk34] {
         let mut eqs = mass_spring_damper(m, k, 0.0, q0);
@@ -152,13 +152,14 @@ fn event_switching_conductance_resistor_to_zero_is_refused() {
     }
 }
 
-/// Se driven by a signal that turns NaN at t = 1 charges C through R (RC = 0.1 s, with a
-/// ripple keeping the steps short). The run stops with `NonFinite` or `Solver` naming the
-/// signal block, and keeps the rows before the failure, which match the analytic charge.
+/// Se driven by a signal that turns NaN at t = 1 drives a current through R and L
+/// (τ = L/R = 0.1 s, a sine keeping the steps short). The run stops with `NonFinite` or
+/// `Solver` naming the signal block, and keeps the rows before the failure, which match the
+/// analytic current.
 #[test]
 fn nan_from_a_signal_stops_the_run_and_keeps_earlier_rows() {
-    let (r, c) = (1.0, 0.1);
-    let tau = r * c;
+    let (r, l) = (1.0, 0.1);
+    let tau = l / r;
     let w = 20.0;
     for method in Method::ALL {
         let mut g = BondGraph::new();
@@ -166,17 +167,18 @@ fn nan_from_a_signal_stops_the_run_and_keeps_earlier_rows() {
         g.add("src", EffortSource::new(Param::modulated(vec!["sig.out".into()], |_, u| u[0]))).unwrap();
         g.add("j", OneJunction).unwrap();
         g.add("R", Resistor::new(r).unwrap()).unwrap();
-        g.add("C", Capacitor::new(c, 0.0).unwrap()).unwrap();
-        bond_all(&mut g, &[("src", "j"), ("j", "R"), ("j", "C")]);
+        g.add("L", Inertia::new(l, 0.0).unwrap()).unwrap();
+        bond_all(&mut g, &[("src", "j"), ("j", "R"), ("j", "L")]);
         let mut eqs = assemble(g);
         let x0 = eqs.initial_state();
-        let outs = [output(&eqs, "C.q"), output(&eqs, "sig.out")];
+        let outs = [output(&eqs, "L.f"), output(&eqs, "sig.out")];
         let run = simulate(&mut eqs, &x0, &settings(method, 2.0, 0.01, 1e-8, 1e-12), &outs, vec![]);
         let err = run.error.clone().unwrap_or_else(|| panic!("{}: the run must fail", method.name()));
         let text = err.to_string();
+        eprintln!("{}: {text}", method.name());
         let t_fail = match &err {
             SimulationError::NonFinite { t, element, culprit, .. } => {
-                assert_eq!(element, "C");
+                assert_eq!(element, "L");
                 assert!(culprit.contains("`sig`"), "{}: {text}", method.name());
                 *t
             }
@@ -186,19 +188,19 @@ fn nan_from_a_signal_stops_the_run_and_keeps_earlier_rows() {
             }
             other => panic!("{}: unexpected error {other:?}", method.name()),
         };
-        assert!(t_fail >= 0.9 && t_fail <= 1.0 + 0.05, "{}: failed at {t_fail}", method.name());
+        assert!((0.9..=1.05).contains(&t_fail), "{}: failed at {t_fail}", method.name());
         let t = col(&run.trajectory, "t");
-        let q = col(&run.trajectory, "C.q");
-        assert!(!t.is_empty(), "{}: no rows kept", method.name());
-        assert!(*t.last().unwrap() <= t_fail + 1e-12 && *t.last().unwrap() < 1.0, "{}: last row {}", method.name(), t.last().unwrap());
-        assert!(t.len() >= 80, "{}: only {} rows kept before t = {t_fail}", method.name(), t.len());
-        for (k, (ti, qi)) in t.iter().zip(&q).enumerate() {
-            assert_abs_diff_eq!(*ti, k as f64 * 0.01, epsilon = 1e-12);
-            // q' = (sin ωt − q/C)/R: q = C·(sin ωt − ωτ·cos ωt + ωτ·e^{−t/τ})/(1 + ω²τ²).
-            let exact = c * ((w * ti).sin() - w * tau * (w * ti).cos() + w * tau * (-ti / tau).exp()) / (1.0 + (w * tau).powi(2));
-            assert_abs_diff_eq!(*qi, exact, epsilon = 1e-6 * c);
+        let i = col(&run.trajectory, "L.f");
+        let last = *t.last().unwrap_or_else(|| panic!("{}: no rows kept", method.name()));
+        assert!(last <= t_fail + 1e-12 && last < 1.0, "{}: last row at {last}", method.name());
+        assert!(t.len() >= 90, "{}: only {} rows kept before t = {t_fail}", method.name(), t.len());
+        for (k, (tk, ik)) in t.iter().zip(&i).enumerate() {
+            assert_abs_diff_eq!(*tk, k as f64 * 0.01, epsilon = 1e-12);
+            // τ·i' + i = sin(ωt)/R: i = (sin ωt − ωτ·cos ωt + ωτ·e^{−t/τ}) / (R·(1 + ω²τ²)).
+            let exact = ((w * tk).sin() - w * tau * (w * tk).cos() + w * tau * (-tk / tau).exp()) / (r * (1.0 + (w * tau).powi(2)));
+            assert_abs_diff_eq!(*ik, exact, epsilon = 1e-6 / r);
         }
-        assert!(run.x_final.len() == 1 && run.t_final >= t[t.len() - 1]);
+        assert!(run.x_final.len() == 1 && run.t_final >= last);
     }
 }
 

@@ -61,28 +61,30 @@ struct EventSpec {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct CheckSpec {
-    column: String,
+    value: String,
     expected: String,
     tol: f64,
 }
 
-/// A check of a result column against an expected expression of `t` and parameters.
+/// A check of the results: at every output row, |value − expected| ≤ tol, where `value` and
+/// `expected` are expressions of `t`, parameters and output columns.
 #[derive(Clone, Debug)]
 pub struct Check {
-    /// Output column checked.
-    pub column: String,
-    /// Expected value, an expression of `t`, parameters and other columns.
+    /// What is checked (a column name or an expression of columns).
+    pub value: String,
+    /// Expected value.
     pub expected: String,
     /// Absolute tolerance.
     pub tol: f64,
-    expr: Expr,
+    value_expr: Expr,
+    expected_expr: Expr,
 }
 
 /// The result of a [`Check`].
 #[derive(Clone, Debug)]
 pub struct CheckResult {
-    /// The check.
-    pub column: String,
+    /// What was checked.
+    pub value: String,
     /// Largest |value − expected| over the rows.
     pub max_error: f64,
     /// Time of the largest error.
@@ -537,11 +539,23 @@ fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
     let mut checks = Vec::new();
     for c in &spec.check {
         let cs = c.get_ref();
-        let expr = Expr::parse(&cs.expected).map_err(|e| source.err(ErrorKind::Settings, Some(&c.span()), format!("[[check]] expected = \"{}\": {e}", cs.expected)))?;
-        if !outputs.iter().any(|o| o.name == cs.column) {
-            return Err(source.err(ErrorKind::Settings, Some(&c.span()), format!("[[check]] column `{}` is not an output", cs.column)));
+        let parse_checked = |what: &str, text: &str| -> Result<Expr, ModelError> {
+            let e = Expr::parse(text).map_err(|e| source.err(ErrorKind::Settings, Some(&c.span()), format!("[[check]] {what} = \"{text}\": {e}")))?;
+            for n in e.names() {
+                if n != "t" && n != "pi" && !parameters.contains_key(&n) && !outputs.iter().any(|o| o.name == n) {
+                    return Err(source
+                        .err(ErrorKind::Settings, Some(&c.span()), format!("[[check]] {what} uses `{n}`, which is neither `t`, a parameter nor an output column"))
+                        .hint("name output columns in [outputs] with plain names (letters, digits, _) to use them in checks"));
+                }
+            }
+            Ok(e)
+        };
+        let value_expr = parse_checked("value", &cs.value)?;
+        let expected_expr = parse_checked("expected", &cs.expected)?;
+        if !(cs.tol.is_finite() && cs.tol >= 0.0) {
+            return Err(source.err(ErrorKind::Settings, Some(&c.span()), format!("[[check]] tol must be finite and >= 0, got {}", cs.tol)));
         }
-        checks.push(Check { column: cs.column.clone(), expected: cs.expected.clone(), tol: cs.tol, expr });
+        checks.push(Check { value: cs.value.clone(), expected: cs.expected.clone(), tol: cs.tol, value_expr, expected_expr });
     }
     let model = Model { title: spec.title, description: spec.description, x0: eqs.initial_state(), equations: eqs, settings, outputs, checks, parameters, source };
     // events must build now, so that their errors show at load time
@@ -655,22 +669,23 @@ impl Model {
         self.checks
             .iter()
             .map(|c| {
-                let j = traj.columns.iter().position(|n| *n == c.column);
                 let mut worst = (0.0f64, f64::NAN);
-                let mut finite = j.is_some() && !traj.rows.is_empty();
+                let mut finite = !traj.rows.is_empty();
                 for row in &traj.rows {
-                    let Some(j) = j else { break };
                     let t = row[0];
-                    let expected = c.expr.eval(&|n| {
+                    let lookup = |n: &str| {
                         if n == "t" {
                             Some(t)
-                        } else if let Some(v) = self.parameters.get(n) {
-                            Some(*v)
+                        } else if let Some(k) = traj.columns.iter().position(|col| col == n) {
+                            Some(row[k])
                         } else {
-                            traj.columns.iter().position(|col| col == n).map(|k| row[k])
+                            self.parameters.get(n).copied()
                         }
-                    });
-                    let err = expected.map_or(f64::NAN, |e| (row[j] - e).abs());
+                    };
+                    let err = match (c.value_expr.eval(&lookup), c.expected_expr.eval(&lookup)) {
+                        (Ok(v), Ok(e)) => (v - e).abs(),
+                        _ => f64::NAN,
+                    };
                     if !err.is_finite() {
                         finite = false;
                     }
@@ -678,7 +693,7 @@ impl Model {
                         worst = (err, t);
                     }
                 }
-                CheckResult { column: c.column.clone(), max_error: worst.0, t_worst: worst.1, tol: c.tol, passed: finite && worst.0 <= c.tol }
+                CheckResult { value: c.value.clone(), max_error: worst.0, t_worst: worst.1, tol: c.tol, passed: finite && worst.0 <= c.tol }
             })
             .collect()
     }

@@ -4,8 +4,8 @@
 //! every component gets the same value. With power-in positive, a source delivering power
 //! has `e·f_in < 0`; draw its bond pointing away from it.
 
-use crate::bond::PortCausality;
-use crate::element::{CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec};
+use crate::bond::PortCausality as Pc;
+use crate::element::{CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Stage};
 
 /// Effort source `Se`: e = e_s(t, signals) on every component.
 #[derive(Debug)]
@@ -28,10 +28,14 @@ impl Element for EffortSource {
         Ports::Fixed(vec![PortSpec::any_dim("1")])
     }
     fn causal_rule(&self, _: usize) -> CausalRule {
-        CausalRule::Fixed(vec![PortCausality::EffortOut])
+        CausalRule::Fixed(vec![Pc::EffortOut])
     }
     fn signal_inputs(&self) -> Vec<SignalSpec> {
         self.value.signal_inputs()
+    }
+    fn stages(&self, causality: &[Pc]) -> Vec<Stage> {
+        // A source's output depends on time and signals only, never on its port.
+        Stage::from_states(causality, self.value.n_inputs(), 0)
     }
     fn eval(&self, _: usize, io: &mut Io<'_>) {
         let v = self.value.value(io, 0);
@@ -63,10 +67,14 @@ impl Element for FlowSource {
         Ports::Fixed(vec![PortSpec::any_dim("1")])
     }
     fn causal_rule(&self, _: usize) -> CausalRule {
-        CausalRule::Fixed(vec![PortCausality::FlowOut])
+        CausalRule::Fixed(vec![Pc::FlowOut])
     }
     fn signal_inputs(&self) -> Vec<SignalSpec> {
         self.value.signal_inputs()
+    }
+    fn stages(&self, causality: &[Pc]) -> Vec<Stage> {
+        // A source's output depends on time and signals only, never on its port.
+        Stage::from_states(causality, self.value.n_inputs(), 0)
     }
     fn eval(&self, _: usize, io: &mut Io<'_>) {
         // The value is the flow *delivered* along the bond: the flow out of the source.
