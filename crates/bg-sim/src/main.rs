@@ -5,12 +5,17 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use bg_model::{inspect, Model, Registry};
+use bg_model::{inspect, Model};
+use bg_sim::registry;
 use bondgraph::{Method, Outcome};
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(name = "bg-sim", version, about = "Simulate port-based bond graphs described in TOML model files")]
+#[command(
+    name = "bg-sim",
+    version,
+    about = "Simulate port-based bond graphs described in TOML model files"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -59,17 +64,30 @@ enum Command {
     Kinds,
 }
 
-/// Every element kind this build knows: the core kinds plus the domain crates'.
-fn registry() -> Registry {
-    Registry::with_core()
-}
-
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
-        Command::Run { model, output, solver, rtol, atol, t_end, dt_out, set, quiet } => {
-            run(&model, output, solver.as_deref(), rtol, atol, t_end, dt_out, &set, quiet)
-        }
+        Command::Run {
+            model,
+            output,
+            solver,
+            rtol,
+            atol,
+            t_end,
+            dt_out,
+            set,
+            quiet,
+        } => run(
+            &model,
+            output,
+            solver.as_deref(),
+            rtol,
+            atol,
+            t_end,
+            dt_out,
+            &set,
+            quiet,
+        ),
         Command::Check { model, set } => check(&model, &set),
         Command::Kinds => {
             for (k, info) in registry().kinds() {
@@ -81,7 +99,17 @@ fn main() -> ExitCode {
 }
 
 #[allow(clippy::too_many_arguments)]
-fn run(path: &Path, output: Option<PathBuf>, solver: Option<&str>, rtol: Option<f64>, atol: Option<f64>, t_end: Option<f64>, dt_out: Option<f64>, set: &[String], quiet: bool) -> ExitCode {
+fn run(
+    path: &Path,
+    output: Option<PathBuf>,
+    solver: Option<&str>,
+    rtol: Option<f64>,
+    atol: Option<f64>,
+    t_end: Option<f64>,
+    dt_out: Option<f64>,
+    set: &[String],
+    quiet: bool,
+) -> ExitCode {
     let mut model = match Model::load(path, &registry(), set) {
         Ok(m) => m,
         Err(e) => {
@@ -115,14 +143,16 @@ fn run(path: &Path, output: Option<PathBuf>, solver: Option<&str>, rtol: Option<
         return ExitCode::from(2);
     }
     let out_path = output.unwrap_or_else(|| {
-        let stem = path.file_stem().map_or_else(|| "model".into(), |s| s.to_string_lossy().into_owned());
+        let stem = path
+            .file_stem()
+            .map_or_else(|| "model".into(), |s| s.to_string_lossy().into_owned());
         PathBuf::from("out").join(format!("{stem}.csv"))
     });
     if !quiet {
         let s = &model.settings;
         println!(
             "{}: {} states, {} → {} s, {} (rtol {:e}, atol {:e}), output every {} s",
-            model.title.as_deref().unwrap_or(&model.file().to_owned()),
+            model.title.as_deref().unwrap_or(model.file()),
             model.equations.n_states(),
             s.t_start,
             s.t_end,
@@ -140,25 +170,43 @@ fn run(path: &Path, output: Option<PathBuf>, solver: Option<&str>, rtol: Option<
         }
     };
     let complete = outcome.error.is_none();
-    let target = if complete { out_path.clone() } else { partial_path(&out_path) };
+    let target = if complete {
+        out_path.clone()
+    } else {
+        partial_path(&out_path)
+    };
     if let Err(e) = write_csv(&target, &outcome) {
         eprintln!("error: cannot write {}: {e}", target.display());
         return ExitCode::from(2);
     }
     if !quiet {
         println!("solver: {}", outcome.stats);
-        println!("wrote {} rows × {} columns to {}", outcome.trajectory.rows.len(), outcome.trajectory.columns.len(), target.display());
+        println!(
+            "wrote {} rows × {} columns to {}",
+            outcome.trajectory.rows.len(),
+            outcome.trajectory.columns.len(),
+            target.display()
+        );
     }
     let mut code = ExitCode::SUCCESS;
     if let Some(e) = &outcome.error {
         eprintln!("error: {}: the run stopped early: {e}", model.file());
-        eprintln!("  the {} rows computed up to t = {} s are in {} ({} was not written)", outcome.trajectory.rows.len(), outcome.t_final, target.display(), out_path.display());
+        eprintln!(
+            "  the {} rows computed up to t = {} s are in {} ({} was not written)",
+            outcome.trajectory.rows.len(),
+            outcome.t_final,
+            target.display(),
+            out_path.display()
+        );
         code = ExitCode::from(1);
     } else {
         for r in model.verify(&outcome.trajectory) {
             let status = if r.passed { "ok  " } else { "FAIL" };
             if !quiet || !r.passed {
-                println!("check {status} {}: max |error| {:.3e} at t = {} (tolerance {:.1e})", r.value, r.max_error, r.t_worst, r.tol);
+                println!(
+                    "check {status} {}: max |error| {:.3e} at t = {} (tolerance {:.1e})",
+                    r.value, r.max_error, r.t_worst, r.tol
+                );
             }
             if !r.passed {
                 code = ExitCode::from(1);
@@ -169,7 +217,9 @@ fn run(path: &Path, output: Option<PathBuf>, solver: Option<&str>, rtol: Option<
 }
 
 fn partial_path(p: &Path) -> PathBuf {
-    let stem = p.file_stem().map_or_else(|| "results".into(), |s| s.to_string_lossy().into_owned());
+    let stem = p
+        .file_stem()
+        .map_or_else(|| "results".into(), |s| s.to_string_lossy().into_owned());
     p.with_file_name(format!("{stem}.partial.csv"))
 }
 
@@ -210,7 +260,10 @@ fn check(path: &Path, set: &[String]) -> ExitCode {
         }
     }
     if !report.bonds.is_empty() {
-        println!("bonds ({}), `|` marks the causal stroke (the end that receives the effort):", report.bonds.len());
+        println!(
+            "bonds ({}), `|` marks the causal stroke (the end that receives the effort):",
+            report.bonds.len()
+        );
         for b in &report.bonds {
             println!("  {b}");
         }

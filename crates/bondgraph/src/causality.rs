@@ -42,7 +42,9 @@ impl CausalGraph {
     /// Causality of every port of element `id`.
     #[must_use]
     pub fn element_causality(&self, id: ElementId) -> Vec<PortCausality> {
-        (0..self.graph.ports_of(id).len()).map(|p| self.port_causality(id, p)).collect()
+        (0..self.graph.ports_of(id).len())
+            .map(|p| self.port_causality(id, p))
+            .collect()
     }
 
     /// A one-line drawing of bond `b`: `from ⇀| to` style in ASCII, e.g. `se --|> j1`
@@ -52,11 +54,21 @@ impl CausalGraph {
         let bond = self.graph.bond(b);
         let from = &self.graph.node(bond.from.element).name;
         let to = &self.graph.node(bond.to.element).name;
-        let dim = if bond.dim > 1 { format!(" [dim {}]", bond.dim) } else { String::new() };
-        if self.effort_setter[b] == bond.from.element {
-            format!("{}: {from} ---|> {to}{dim}   (effort {from} -> {to}, flow {to} -> {from})", bond.name)
+        let dim = if bond.dim > 1 {
+            format!(" [dim {}]", bond.dim)
         } else {
-            format!("{}: {from} |---> {to}{dim}   (effort {to} -> {from}, flow {from} -> {to})", bond.name)
+            String::new()
+        };
+        if self.effort_setter[b] == bond.from.element {
+            format!(
+                "{}: {from} ---|> {to}{dim}   (effort {from} -> {to}, flow {to} -> {from})",
+                bond.name
+            )
+        } else {
+            format!(
+                "{}: {from} |---> {to}{dim}   (effort {to} -> {from}, flow {from} -> {to})",
+                bond.name
+            )
         }
     }
 }
@@ -94,11 +106,22 @@ pub fn assign_causality(mut graph: BondGraph) -> Result<CausalGraph, crate::Erro
         let rules = (0..graph.n_elements())
             .map(|id| graph.node(id).element.causal_rule(graph.ports_of(id).len()))
             .collect();
-        let mut s = Scap { g: &graph, rules, decided: vec![None; graph.n_bonds()], queue: VecDeque::new() };
+        let mut s = Scap {
+            g: &graph,
+            rules,
+            decided: vec![None; graph.n_bonds()],
+            queue: VecDeque::new(),
+        };
         s.run()?;
-        s.decided.iter().map(|d| d.map_or(0, |d| d.setter)).collect()
+        s.decided
+            .iter()
+            .map(|d| d.map_or(0, |d| d.setter))
+            .collect()
     };
-    Ok(CausalGraph { graph, effort_setter: setter })
+    Ok(CausalGraph {
+        graph,
+        effort_setter: setter,
+    })
 }
 
 impl Scap<'_> {
@@ -130,7 +153,14 @@ impl Scap<'_> {
                         self.propagate()?;
                     }
                     None => {
-                        let bond = self.g.ports_of(id).iter().flatten().copied().next().unwrap_or(0);
+                        let bond = self
+                            .g
+                            .ports_of(id)
+                            .iter()
+                            .flatten()
+                            .copied()
+                            .next()
+                            .unwrap_or(0);
                         return Err(self.explain(Failure::Conflict { at: id, bond }));
                     }
                 }
@@ -148,7 +178,12 @@ impl Scap<'_> {
     }
 
     fn open_ports(&self, id: ElementId) -> usize {
-        self.g.ports_of(id).iter().flatten().filter(|&&b| self.decided[b].is_none()).count()
+        self.g
+            .ports_of(id)
+            .iter()
+            .flatten()
+            .filter(|&&b| self.decided[b].is_none())
+            .count()
     }
 
     fn current(&self, id: ElementId) -> Vec<Option<PortCausality>> {
@@ -156,12 +191,24 @@ impl Scap<'_> {
             .ports_of(id)
             .iter()
             .map(|b| {
-                b.and_then(|b| self.decided[b]).map(|d| if d.setter == id { PortCausality::EffortOut } else { PortCausality::FlowOut })
+                b.and_then(|b| self.decided[b]).map(|d| {
+                    if d.setter == id {
+                        PortCausality::EffortOut
+                    } else {
+                        PortCausality::FlowOut
+                    }
+                })
             })
             .collect()
     }
 
-    fn decide(&mut self, bond: BondId, setter: ElementId, by: ElementId, cause: Option<BondId>) -> Result<(), CausalityError> {
+    fn decide(
+        &mut self,
+        bond: BondId,
+        setter: ElementId,
+        by: ElementId,
+        cause: Option<BondId>,
+    ) -> Result<(), CausalityError> {
         match self.decided[bond] {
             Some(d) if d.setter != setter => Err(self.explain(Failure::Conflict { at: by, bond })),
             Some(_) => Ok(()),
@@ -178,10 +225,21 @@ impl Scap<'_> {
         }
     }
 
-    fn assign_pattern(&mut self, id: ElementId, pattern: &[PortCausality], cause: Option<BondId>) -> Result<(), CausalityError> {
+    fn assign_pattern(
+        &mut self,
+        id: ElementId,
+        pattern: &[PortCausality],
+        cause: Option<BondId>,
+    ) -> Result<(), CausalityError> {
         for (port, &c) in pattern.iter().enumerate() {
-            let Some(b) = self.g.ports_of(id)[port] else { continue };
-            let setter = if c == PortCausality::EffortOut { id } else { self.other_end(b, id) };
+            let Some(b) = self.g.ports_of(id)[port] else {
+                continue;
+            };
+            let setter = if c == PortCausality::EffortOut {
+                id
+            } else {
+                self.other_end(b, id)
+            };
             self.decide(b, setter, id, cause)?;
         }
         Ok(())
@@ -196,7 +254,11 @@ impl Scap<'_> {
         }
     }
 
-    fn apply_and_propagate(&mut self, id: ElementId, cause: Option<BondId>) -> Result<(), CausalityError> {
+    fn apply_and_propagate(
+        &mut self,
+        id: ElementId,
+        cause: Option<BondId>,
+    ) -> Result<(), CausalityError> {
         self.apply(id, cause)?;
         self.propagate()
     }
@@ -212,7 +274,14 @@ impl Scap<'_> {
     fn apply(&mut self, id: ElementId, cause: Option<BondId>) -> Result<(), CausalityError> {
         let current = self.current(id);
         let ports: Vec<Option<BondId>> = self.g.ports_of(id).to_vec();
-        let conflict = |this: &Self| this.explain(Failure::Conflict { at: id, bond: cause.or_else(|| ports.iter().flatten().copied().next()).unwrap_or(0) });
+        let conflict = |this: &Self| {
+            this.explain(Failure::Conflict {
+                at: id,
+                bond: cause
+                    .or_else(|| ports.iter().flatten().copied().next())
+                    .unwrap_or(0),
+            })
+        };
         match self.rules[id].clone() {
             CausalRule::None => Ok(()),
             CausalRule::Fixed(p) | CausalRule::Integral(p) => {
@@ -222,7 +291,10 @@ impl Scap<'_> {
                 self.assign_pattern(id, &p, cause)
             }
             CausalRule::Resistive(patterns) => {
-                let ok: Vec<&Vec<PortCausality>> = patterns.iter().filter(|p| consistent(p, &current)).collect();
+                let ok: Vec<&Vec<PortCausality>> = patterns
+                    .iter()
+                    .filter(|p| consistent(p, &current))
+                    .collect();
                 if ok.is_empty() {
                     return Err(conflict(self));
                 }
@@ -249,7 +321,10 @@ impl Scap<'_> {
                     None
                 };
                 if let Some(f) = fill {
-                    let forced: Vec<Option<PortCausality>> = current.iter().map(|x| if x.is_none() { Some(f) } else { None }).collect();
+                    let forced: Vec<Option<PortCausality>> = current
+                        .iter()
+                        .map(|x| if x.is_none() { Some(f) } else { None })
+                        .collect();
                     self.assign_partial(id, &forced, cause)?;
                 }
                 Ok(())
@@ -260,7 +335,10 @@ impl Scap<'_> {
                     if known.iter().any(|&k| k != first) {
                         return Err(conflict(self));
                     }
-                    let forced: Vec<Option<PortCausality>> = current.iter().map(|x| if x.is_none() { Some(first) } else { None }).collect();
+                    let forced: Vec<Option<PortCausality>> = current
+                        .iter()
+                        .map(|x| if x.is_none() { Some(first) } else { None })
+                        .collect();
                     self.assign_partial(id, &forced, cause)?;
                 }
                 Ok(())
@@ -268,10 +346,21 @@ impl Scap<'_> {
         }
     }
 
-    fn assign_partial(&mut self, id: ElementId, forced: &[Option<PortCausality>], cause: Option<BondId>) -> Result<(), CausalityError> {
+    fn assign_partial(
+        &mut self,
+        id: ElementId,
+        forced: &[Option<PortCausality>],
+        cause: Option<BondId>,
+    ) -> Result<(), CausalityError> {
         for (port, c) in forced.iter().enumerate() {
-            let (Some(c), Some(b)) = (c, self.g.ports_of(id)[port]) else { continue };
-            let setter = if *c == PortCausality::EffortOut { id } else { self.other_end(b, id) };
+            let (Some(c), Some(b)) = (c, self.g.ports_of(id)[port]) else {
+                continue;
+            };
+            let setter = if *c == PortCausality::EffortOut {
+                id
+            } else {
+                self.other_end(b, id)
+            };
             self.decide(b, setter, id, cause)?;
         }
         Ok(())
@@ -289,7 +378,9 @@ impl Scap<'_> {
         let mut guard = 0;
         while let Some(d) = next {
             let by = self.g.node(d.by);
-            let b = d.cause.map_or_else(String::new, |c| format!(" (because of {})", self.g.bond(c).name));
+            let b = d.cause.map_or_else(String::new, |c| {
+                format!(" (because of {})", self.g.bond(c).name)
+            });
             chain.push(format!("{} ({}){b}", by.name, by.element.kind()));
             origin = Some(d.by);
             next = d.cause.and_then(|c| self.decided[c]);
@@ -303,7 +394,10 @@ impl Scap<'_> {
         } else {
             format!("its causality was set by {}", chain.join(" <- "))
         };
-        let origin_name = origin.map_or_else(|| "the rest of the graph".to_owned(), |o| format!("`{}`", self.g.node(o).name));
+        let origin_name = origin.map_or_else(
+            || "the rest of the graph".to_owned(),
+            |o| format!("`{}`", self.g.node(o).name),
+        );
         let origin_kind = origin.map(|o| self.rules[o].clone());
         match &self.rules[at] {
             CausalRule::Integral(p) => {
@@ -342,5 +436,9 @@ impl Scap<'_> {
 }
 
 fn consistent(pattern: &[PortCausality], current: &[Option<PortCausality>]) -> bool {
-    pattern.len() == current.len() && pattern.iter().zip(current).all(|(p, c)| c.is_none_or(|c| c == *p))
+    pattern.len() == current.len()
+        && pattern
+            .iter()
+            .zip(current)
+            .all(|(p, c)| c.is_none_or(|c| c == *p))
 }

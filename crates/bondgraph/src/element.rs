@@ -31,12 +31,18 @@ impl PortSpec {
     /// A port of fixed dimension.
     #[must_use]
     pub fn new(name: &str, dim: usize) -> Self {
-        Self { name: name.to_owned(), dim: Some(dim) }
+        Self {
+            name: name.to_owned(),
+            dim: Some(dim),
+        }
     }
     /// A port that takes the dimension of its bond.
     #[must_use]
     pub fn any_dim(name: &str) -> Self {
-        Self { name: name.to_owned(), dim: None }
+        Self {
+            name: name.to_owned(),
+            dim: None,
+        }
     }
 }
 
@@ -55,7 +61,11 @@ impl StateSpec {
     /// A state with nominal magnitude 1.
     #[must_use]
     pub fn new(name: &str, initial: f64) -> Self {
-        Self { name: name.to_owned(), initial, nominal: 1.0 }
+        Self {
+            name: name.to_owned(),
+            initial,
+            nominal: 1.0,
+        }
     }
     /// Set the nominal magnitude used to scale the absolute tolerance.
     #[must_use]
@@ -78,7 +88,10 @@ impl SignalSpec {
     /// A scalar signal.
     #[must_use]
     pub fn scalar(name: &str) -> Self {
-        Self { name: name.to_owned(), dim: 1 }
+        Self {
+            name: name.to_owned(),
+            dim: 1,
+        }
     }
 }
 
@@ -150,7 +163,11 @@ impl Stage {
     /// A stage computing outputs from states only (storage elements): writes every
     /// `EffortOut` effort / `FlowOut` flow and all signal outputs, reading only signal inputs.
     #[must_use]
-    pub fn from_states(causality: &[PortCausality], n_inputs: usize, n_outputs: usize) -> Vec<Stage> {
+    pub fn from_states(
+        causality: &[PortCausality],
+        n_inputs: usize,
+        n_outputs: usize,
+    ) -> Vec<Stage> {
         let mut stage = Stage::default();
         for (i, c) in causality.iter().enumerate() {
             stage.writes.push(match c {
@@ -197,7 +214,11 @@ pub trait Element: Debug {
     /// How the computation splits into stages for the assigned causality
     /// (default: one stage, every output from every input).
     fn stages(&self, causality: &[PortCausality]) -> Vec<Stage> {
-        Stage::single(causality, self.signal_inputs().len(), self.signal_outputs().len())
+        Stage::single(
+            causality,
+            self.signal_inputs().len(),
+            self.signal_outputs().len(),
+        )
     }
 
     /// Compute the variables written by `stage`.
@@ -357,6 +378,9 @@ impl<'a> Io<'a> {
     }
 }
 
+/// The law of a modulated [`Param`]: `value = law(t, inputs)`.
+pub type ParamLaw = Box<dyn Fn(f64, &[f64]) -> f64>;
+
 /// A coefficient that is either constant or a function of time and scalar signal inputs
 /// (a *modulated* parameter: the ratio of an MTF, the resistance of a valve, a source value).
 pub enum Param {
@@ -367,7 +391,7 @@ pub enum Param {
         /// Names of the signals read, in the order `law` receives them.
         inputs: Vec<String>,
         /// The law.
-        law: Box<dyn Fn(f64, &[f64]) -> f64>,
+        law: ParamLaw,
     },
 }
 
@@ -377,14 +401,19 @@ pub const MAX_PARAM_INPUTS: usize = 16;
 impl Param {
     /// A modulated parameter.
     pub fn modulated(inputs: Vec<String>, law: impl Fn(f64, &[f64]) -> f64 + 'static) -> Self {
-        Self::Modulated { inputs, law: Box::new(law) }
+        Self::Modulated {
+            inputs,
+            law: Box::new(law),
+        }
     }
     /// Signals read, as specs (scalar).
     #[must_use]
     pub fn signal_inputs(&self) -> Vec<SignalSpec> {
         match self {
             Self::Const(_) => Vec::new(),
-            Self::Modulated { inputs, .. } => inputs.iter().map(|n| SignalSpec::scalar(n)).collect(),
+            Self::Modulated { inputs, .. } => {
+                inputs.iter().map(|n| SignalSpec::scalar(n)).collect()
+            }
         }
     }
     /// Number of signal inputs.

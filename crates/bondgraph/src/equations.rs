@@ -91,7 +91,10 @@ impl StateEquations {
     /// # Complexity
     /// O(S + D) for S stages and D data dependencies.
     pub fn new(causal: CausalGraph) -> Result<Self, crate::Error> {
-        let CausalGraph { graph, effort_setter } = causal;
+        let CausalGraph {
+            graph,
+            effort_setter,
+        } = causal;
         let n_el = graph.n_elements();
         // Bond storage.
         let mut bond_offset = Vec::with_capacity(graph.n_bonds());
@@ -108,9 +111,18 @@ impl StateEquations {
         for id in 0..n_el {
             let node = graph.node(id);
             let specs = node.element.states();
-            let mut layout = Layout { state_offset: states.len(), n_states: specs.len(), ..Layout::default() };
+            let mut layout = Layout {
+                state_offset: states.len(),
+                n_states: specs.len(),
+                ..Layout::default()
+            };
             for s in specs {
-                states.push(StateInfo { name: format!("{}.{}", node.name, s.name), element: id, initial: s.initial, nominal: s.nominal });
+                states.push(StateInfo {
+                    name: format!("{}.{}", node.name, s.name),
+                    element: id,
+                    initial: s.initial,
+                    nominal: s.nominal,
+                });
             }
             for s in node.element.signal_outputs() {
                 layout.outputs.push((n_signals, s.dim));
@@ -120,9 +132,22 @@ impl StateEquations {
             for (port, b) in graph.ports_of(id).iter().enumerate() {
                 let b = b.unwrap_or(0);
                 let bond = graph.bond(b);
-                let sign = if bond.to.element == id && bond.to.port == port { 1.0 } else { -1.0 };
-                let causality = if effort_setter[b] == id { PortCausality::EffortOut } else { PortCausality::FlowOut };
-                layout.ports.push(PortLayout { offset: bond_offset[b], dim: bond.dim, sign, causality });
+                let sign = if bond.to.element == id && bond.to.port == port {
+                    1.0
+                } else {
+                    -1.0
+                };
+                let causality = if effort_setter[b] == id {
+                    PortCausality::EffortOut
+                } else {
+                    PortCausality::FlowOut
+                };
+                layout.ports.push(PortLayout {
+                    offset: bond_offset[b],
+                    dim: bond.dim,
+                    sign,
+                    causality,
+                });
             }
             layouts.push(layout);
         }
@@ -154,11 +179,13 @@ impl StateEquations {
             let inputs = self.graph.node(id).element.signal_inputs();
             let mut resolved = Vec::with_capacity(inputs.len());
             for spec in inputs {
-                let (src, dim) = self.resolve(&spec.name).ok_or_else(|| GraphError::UnknownSignal {
-                    element: self.graph.node(id).name.clone(),
-                    signal: spec.name.clone(),
-                    hint: self.suggest(&spec.name),
-                })?;
+                let (src, dim) =
+                    self.resolve(&spec.name)
+                        .ok_or_else(|| GraphError::UnknownSignal {
+                            element: self.graph.node(id).name.clone(),
+                            signal: spec.name.clone(),
+                            hint: self.suggest(&spec.name),
+                        })?;
                 if dim != spec.dim {
                     return Err(GraphError::SignalDimension {
                         element: self.graph.node(id).name.clone(),
@@ -184,7 +211,9 @@ impl StateEquations {
             return Some((Source::State(i), 1));
         }
         // A vector state `x.q` names all components `x.q[0]..`.
-        let comps: Vec<usize> = (0..self.states.len()).filter(|&i| self.states[i].name.starts_with(&format!("{name}["))).collect();
+        let comps: Vec<usize> = (0..self.states.len())
+            .filter(|&i| self.states[i].name.starts_with(&format!("{name}[")))
+            .collect();
         if !comps.is_empty() && comps.windows(2).all(|w| w[1] == w[0] + 1) {
             return Some((Source::State(comps[0]), comps.len()));
         }
@@ -221,7 +250,11 @@ impl StateEquations {
 
     fn suggest(&self, name: &str) -> String {
         let el = name.split('.').next().unwrap_or(name);
-        let mut names: Vec<String> = self.probe_names().into_iter().filter(|n| n.starts_with(&format!("{el}."))).collect();
+        let mut names: Vec<String> = self
+            .probe_names()
+            .into_iter()
+            .filter(|n| n.starts_with(&format!("{el}.")))
+            .collect();
         names.truncate(12);
         if names.is_empty() {
             format!("no element `{el}`; signals are written `<element>.<state or signal>`, `<element>.e`, `<element>.f` or `t`")
@@ -238,8 +271,16 @@ impl StateEquations {
             Slot::Output(i) => Some(Var::Signal(id, i)),
             Slot::Input(i) => match self.layouts[id].inputs.get(i)?.0 {
                 Source::Time | Source::State(_) => None,
-                Source::Effort(o) => self.bond_offset.iter().rposition(|&b| b <= o).map(Var::Effort),
-                Source::Flow(o) => self.bond_offset.iter().rposition(|&b| b <= o).map(Var::Flow),
+                Source::Effort(o) => self
+                    .bond_offset
+                    .iter()
+                    .rposition(|&b| b <= o)
+                    .map(Var::Effort),
+                Source::Flow(o) => self
+                    .bond_offset
+                    .iter()
+                    .rposition(|&b| b <= o)
+                    .map(Var::Flow),
                 Source::Signal(o) => self.signal_owner(o),
             },
         }
@@ -247,7 +288,10 @@ impl StateEquations {
 
     fn signal_owner(&self, offset: usize) -> Option<Var> {
         self.layouts.iter().enumerate().find_map(|(id, l)| {
-            l.outputs.iter().position(|&(o, d)| offset >= o && offset < o + d).map(|i| Var::Signal(id, i))
+            l.outputs
+                .iter()
+                .position(|&(o, d)| offset >= o && offset < o + d)
+                .map(|i| Var::Signal(id, i))
         })
     }
 
@@ -259,9 +303,14 @@ impl StateEquations {
         self.writes = Vec::with_capacity(n_el);
         for id in 0..n_el {
             let node = self.graph.node(id);
-            let causality: Vec<PortCausality> = self.layouts[id].ports.iter().map(|p| p.causality).collect();
+            let causality: Vec<PortCausality> =
+                self.layouts[id].ports.iter().map(|p| p.causality).collect();
             let stages = node.element.stages(&causality);
-            let contract = |message: String| GraphError::Contract { element: node.name.clone(), kind: node.element.kind().to_owned(), message };
+            let contract = |message: String| GraphError::Contract {
+                element: node.name.clone(),
+                kind: node.element.kind().to_owned(),
+                message,
+            };
             let mut el_writes = Vec::with_capacity(stages.len());
             for (s, stage) in stages.iter().enumerate() {
                 let ix = dep.add_node((id, s));
@@ -273,13 +322,21 @@ impl StateEquations {
                         Slot::Output(i) => i < self.layouts[id].outputs.len(),
                         Slot::Input(_) => false,
                     };
-                    let var = self.var_of(id, slot).filter(|_| ok).ok_or_else(|| contract(format!("stage {s} writes {slot:?}, which its causality does not allow")))?;
+                    let var = self.var_of(id, slot).filter(|_| ok).ok_or_else(|| {
+                        contract(format!(
+                            "stage {s} writes {slot:?}, which its causality does not allow"
+                        ))
+                    })?;
                     if writer.insert(var, ix).is_some() {
                         return Err(contract(format!("{slot:?} is written by two stages")).into());
                     }
                     w.push(var);
                 }
-                let r: Vec<Var> = stage.reads.iter().filter_map(|&slot| self.var_of(id, slot)).collect();
+                let r: Vec<Var> = stage
+                    .reads
+                    .iter()
+                    .filter_map(|&slot| self.var_of(id, slot))
+                    .collect();
                 reads.push((ix, r));
                 el_writes.push(w);
             }
@@ -300,7 +357,15 @@ impl StateEquations {
                     return Err(GraphError::Contract {
                         element: n.name.clone(),
                         kind: n.element.kind().to_owned(),
-                        message: format!("no stage computes the {} of bond {}", if matches!(var, Var::Effort(_)) { "effort" } else { "flow" }, bond.name),
+                        message: format!(
+                            "no stage computes the {} of bond {}",
+                            if matches!(var, Var::Effort(_)) {
+                                "effort"
+                            } else {
+                                "flow"
+                            },
+                            bond.name
+                        ),
                     }
                     .into());
                 }
@@ -310,7 +375,12 @@ impl StateEquations {
             for i in 0..l.outputs.len() {
                 if !writer.contains_key(&Var::Signal(id, i)) {
                     let n = self.graph.node(id);
-                    return Err(GraphError::Contract { element: n.name.clone(), kind: n.element.kind().to_owned(), message: format!("no stage computes signal output {i}") }.into());
+                    return Err(GraphError::Contract {
+                        element: n.name.clone(),
+                        kind: n.element.kind().to_owned(),
+                        message: format!("no stage computes signal output {i}"),
+                    }
+                    .into());
                 }
             }
         }
@@ -336,7 +406,10 @@ impl StateEquations {
         reads: &[(petgraph::graph::NodeIndex, Vec<Var>)],
         writer: &HashMap<Var, petgraph::graph::NodeIndex>,
     ) -> CausalityError {
-        let scc = tarjan_scc(dep).into_iter().find(|c| c.len() > 1 || dep.contains_edge(c[0], c[0])).unwrap_or_default();
+        let scc = tarjan_scc(dep)
+            .into_iter()
+            .find(|c| c.len() > 1 || dep.contains_edge(c[0], c[0]))
+            .unwrap_or_default();
         let mut elements: Vec<String> = Vec::new();
         let mut bonds: Vec<String> = Vec::new();
         for &ix in &scc {
@@ -394,7 +467,13 @@ impl StateEquations {
 
     /// Set the initial value of a state by name.
     pub fn set_initial(&mut self, name: &str, value: f64) -> Result<(), GraphError> {
-        let s = self.states.iter_mut().find(|s| s.name == name).ok_or_else(|| GraphError::UnknownElement { name: name.to_owned() })?;
+        let s = self
+            .states
+            .iter_mut()
+            .find(|s| s.name == name)
+            .ok_or_else(|| GraphError::UnknownElement {
+                name: name.to_owned(),
+            })?;
         s.initial = value;
         Ok(())
     }
@@ -402,16 +481,27 @@ impl StateEquations {
     /// Evaluation order: (element, stage) pairs.
     #[must_use]
     pub fn order(&self) -> Vec<(String, usize)> {
-        self.order.iter().map(|&(id, s)| (self.graph.node(id).name.clone(), s)).collect()
+        self.order
+            .iter()
+            .map(|&(id, s)| (self.graph.node(id).name.clone(), s))
+            .collect()
     }
 
     /// Replace element `id` by one of identical shape (used by scheduled events).
-    pub fn replace(&mut self, id: ElementId, element: Box<dyn Element>) -> Result<Box<dyn Element>, GraphError> {
+    pub fn replace(
+        &mut self,
+        id: ElementId,
+        element: Box<dyn Element>,
+    ) -> Result<Box<dyn Element>, GraphError> {
         self.graph.replace(id, element)
     }
 
     /// Check a replacement would be accepted, without doing it.
-    pub fn check_replacement(&self, id: ElementId, element: &dyn Element) -> Result<(), GraphError> {
+    pub fn check_replacement(
+        &self,
+        id: ElementId,
+        element: &dyn Element,
+    ) -> Result<(), GraphError> {
         let n = self.graph.node(id);
         check_same_shape(&n.name, n.element.as_ref(), element)
     }
@@ -419,19 +509,49 @@ impl StateEquations {
     /// dx/dt = f(t, x).
     pub fn rhs(&self, t: f64, x: &[f64], dx: &mut [f64]) {
         let mut ws = self.ws.borrow_mut();
-        let Workspace { effort, flow, signals, .. } = &mut *ws;
+        let Workspace {
+            effort,
+            flow,
+            signals,
+            ..
+        } = &mut *ws;
         self.eval_into(t, x, effort, flow, signals, dx);
     }
 
-    fn eval_into(&self, t: f64, x: &[f64], effort: &mut [f64], flow: &mut [f64], signals: &mut [f64], dx: &mut [f64]) {
+    fn eval_into(
+        &self,
+        t: f64,
+        x: &[f64],
+        effort: &mut [f64],
+        flow: &mut [f64],
+        signals: &mut [f64],
+        dx: &mut [f64],
+    ) {
         for &(id, stage) in &self.order {
-            let mut io = Io { t, x, effort, flow, signals, layout: &self.layouts[id] };
+            let mut io = Io {
+                t,
+                x,
+                effort,
+                flow,
+                signals,
+                layout: &self.layouts[id],
+            };
             self.graph.node(id).element.eval(stage, &mut io);
         }
         for (id, l) in self.layouts.iter().enumerate() {
             if l.n_states > 0 {
-                let io = Io { t, x, effort, flow, signals, layout: l };
-                self.graph.node(id).element.derivatives(&io, &mut dx[l.state_offset..l.state_offset + l.n_states]);
+                let io = Io {
+                    t,
+                    x,
+                    effort,
+                    flow,
+                    signals,
+                    layout: l,
+                };
+                self.graph
+                    .node(id)
+                    .element
+                    .derivatives(&io, &mut dx[l.state_offset..l.state_offset + l.n_states]);
             }
         }
     }
@@ -439,7 +559,12 @@ impl StateEquations {
     /// Evaluate everything at (t, x) and keep it for [`read`](Self::read).
     pub fn evaluate(&self, t: f64, x: &[f64]) {
         let mut ws = self.ws.borrow_mut();
-        let Workspace { effort, flow, signals, dx } = &mut *ws;
+        let Workspace {
+            effort,
+            flow,
+            signals,
+            dx,
+        } = &mut *ws;
         self.eval_into(t, x, effort, flow, signals, dx);
     }
 
@@ -468,7 +593,12 @@ impl StateEquations {
         self.layouts[id]
             .ports
             .iter()
-            .map(|p| p.sign * (p.offset..p.offset + p.dim).map(|k| ws.effort[k] * ws.flow[k]).sum::<f64>())
+            .map(|p| {
+                p.sign
+                    * (p.offset..p.offset + p.dim)
+                        .map(|k| ws.effort[k] * ws.flow[k])
+                        .sum::<f64>()
+            })
             .sum()
     }
 
@@ -479,7 +609,11 @@ impl StateEquations {
         self.layouts[id]
             .ports
             .iter()
-            .map(|p| (p.offset..p.offset + p.dim).map(|k| (ws.effort[k] * ws.flow[k]).abs()).sum::<f64>())
+            .map(|p| {
+                (p.offset..p.offset + p.dim)
+                    .map(|k| (ws.effort[k] * ws.flow[k]).abs())
+                    .sum::<f64>()
+            })
             .fold(0.0, f64::max)
     }
 
@@ -490,7 +624,12 @@ impl StateEquations {
             .iter()
             .enumerate()
             .filter(|(_, l)| l.n_states > 0)
-            .filter_map(|(id, l)| self.graph.node(id).element.stored_energy(&x[l.state_offset..l.state_offset + l.n_states]))
+            .filter_map(|(id, l)| {
+                self.graph
+                    .node(id)
+                    .element
+                    .stored_energy(&x[l.state_offset..l.state_offset + l.n_states])
+            })
             .sum()
     }
 
@@ -511,7 +650,11 @@ impl StateEquations {
             let node = self.graph.node(id);
             let ports = self.graph.ports_of(id);
             for p in 0..ports.len() {
-                let head = if ports.len() == 1 { node.name.clone() } else { format!("{}.{}", node.name, self.graph.port_name(id, p)) };
+                let head = if ports.len() == 1 {
+                    node.name.clone()
+                } else {
+                    format!("{}.{}", node.name, self.graph.port_name(id, p))
+                };
                 names.extend(["e", "f", "P"].iter().map(|v| format!("{head}.{v}")));
             }
         }
@@ -559,33 +702,78 @@ impl StateEquations {
     pub fn first_non_finite(&self, t: f64, x: &[f64]) -> Option<String> {
         let mut effort = vec![0.0; self.n_bond_values];
         let mut flow = vec![0.0; self.n_bond_values];
-        let mut signals = vec![0.0; self.signal_names.iter().map(|(_, o, d)| o + d).max().unwrap_or(0)];
+        let mut signals = vec![
+            0.0;
+            self.signal_names
+                .iter()
+                .map(|(_, o, d)| o + d)
+                .max()
+                .unwrap_or(0)
+        ];
         for &(id, stage) in &self.order {
-            let mut io = Io { t, x, effort: &mut effort, flow: &mut flow, signals: &mut signals, layout: &self.layouts[id] };
+            let mut io = Io {
+                t,
+                x,
+                effort: &mut effort,
+                flow: &mut flow,
+                signals: &mut signals,
+                layout: &self.layouts[id],
+            };
             let node = self.graph.node(id);
             node.element.eval(stage, &mut io);
             for var in &self.writes[id][stage] {
                 let (what, vals) = match *var {
-                    Var::Effort(b) => (format!("effort of bond {}", self.graph.bond(b).name), &effort[self.bond_offset[b]..self.bond_offset[b] + self.graph.bond(b).dim]),
-                    Var::Flow(b) => (format!("flow of bond {}", self.graph.bond(b).name), &flow[self.bond_offset[b]..self.bond_offset[b] + self.graph.bond(b).dim]),
+                    Var::Effort(b) => (
+                        format!("effort of bond {}", self.graph.bond(b).name),
+                        &effort[self.bond_offset[b]..self.bond_offset[b] + self.graph.bond(b).dim],
+                    ),
+                    Var::Flow(b) => (
+                        format!("flow of bond {}", self.graph.bond(b).name),
+                        &flow[self.bond_offset[b]..self.bond_offset[b] + self.graph.bond(b).dim],
+                    ),
                     Var::Signal(e, i) => {
                         let (o, d) = self.layouts[e].outputs[i];
-                        (format!("signal {}", self.signal_names.iter().find(|s| s.1 == o).map_or("?", |s| s.0.as_str())), &signals[o..o + d])
+                        (
+                            format!(
+                                "signal {}",
+                                self.signal_names
+                                    .iter()
+                                    .find(|s| s.1 == o)
+                                    .map_or("?", |s| s.0.as_str())
+                            ),
+                            &signals[o..o + d],
+                        )
                     }
                 };
                 if let Some(v) = vals.iter().find(|v| !v.is_finite()) {
-                    return Some(format!("{what} = {v}, computed by `{}` ({})", node.name, node.element.kind()));
+                    return Some(format!(
+                        "{what} = {v}, computed by `{}` ({})",
+                        node.name,
+                        node.element.kind()
+                    ));
                 }
             }
         }
         let mut dx = vec![0.0; self.states.len()];
         for (id, l) in self.layouts.iter().enumerate() {
             if l.n_states > 0 {
-                let io = Io { t, x, effort: &mut effort, flow: &mut flow, signals: &mut signals, layout: l };
-                self.graph.node(id).element.derivatives(&io, &mut dx[l.state_offset..l.state_offset + l.n_states]);
+                let io = Io {
+                    t,
+                    x,
+                    effort: &mut effort,
+                    flow: &mut flow,
+                    signals: &mut signals,
+                    layout: l,
+                };
+                self.graph
+                    .node(id)
+                    .element
+                    .derivatives(&io, &mut dx[l.state_offset..l.state_offset + l.n_states]);
             }
         }
-        dx.iter().position(|v| !v.is_finite()).map(|i| format!("derivative of state {} = {}", self.states[i].name, dx[i]))
+        dx.iter()
+            .position(|v| !v.is_finite())
+            .map(|i| format!("derivative of state {} = {}", self.states[i].name, dx[i]))
     }
 }
 

@@ -33,7 +33,11 @@ impl ParamError {
         if value.is_finite() && value > 0.0 {
             Ok(value)
         } else {
-            Err(Self::OutOfRange { param: param.into(), value, requirement: "finite and > 0" })
+            Err(Self::OutOfRange {
+                param: param.into(),
+                value,
+                requirement: "finite and > 0",
+            })
         }
     }
     /// Check `value` is finite and `>= 0`.
@@ -41,7 +45,11 @@ impl ParamError {
         if value.is_finite() && value >= 0.0 {
             Ok(value)
         } else {
-            Err(Self::OutOfRange { param: param.into(), value, requirement: "finite and >= 0" })
+            Err(Self::OutOfRange {
+                param: param.into(),
+                value,
+                requirement: "finite and >= 0",
+            })
         }
     }
     /// Check `value` is finite.
@@ -49,7 +57,11 @@ impl ParamError {
         if value.is_finite() {
             Ok(value)
         } else {
-            Err(Self::OutOfRange { param: param.into(), value, requirement: "finite" })
+            Err(Self::OutOfRange {
+                param: param.into(),
+                value,
+                requirement: "finite",
+            })
         }
     }
     /// Check `value` is finite and non-zero.
@@ -57,7 +69,11 @@ impl ParamError {
         if value.is_finite() && value != 0.0 {
             Ok(value)
         } else {
-            Err(Self::OutOfRange { param: param.into(), value, requirement: "finite and non-zero" })
+            Err(Self::OutOfRange {
+                param: param.into(),
+                value,
+                requirement: "finite and non-zero",
+            })
         }
     }
 }
@@ -139,7 +155,9 @@ pub enum GraphError {
         hint: String,
     },
     /// A signal has the wrong dimension.
-    #[error("element `{element}` reads signal `{signal}` of dimension {found}, but needs {expected}")]
+    #[error(
+        "element `{element}` reads signal `{signal}` of dimension {found}, but needs {expected}"
+    )]
     SignalDimension {
         /// Reading element.
         element: String,

@@ -33,20 +33,36 @@ impl BondGraph {
     }
 
     /// Add an element under a unique `name`.
-    pub fn add(&mut self, name: &str, element: impl Element + 'static) -> Result<ElementId, GraphError> {
+    pub fn add(
+        &mut self,
+        name: &str,
+        element: impl Element + 'static,
+    ) -> Result<ElementId, GraphError> {
         self.add_boxed(name, Box::new(element))
     }
 
     /// Add a boxed element under a unique `name`.
-    pub fn add_boxed(&mut self, name: &str, element: Box<dyn Element>) -> Result<ElementId, GraphError> {
+    pub fn add_boxed(
+        &mut self,
+        name: &str,
+        element: Box<dyn Element>,
+    ) -> Result<ElementId, GraphError> {
         if self.find(name).is_some() {
-            return Err(GraphError::DuplicateName { name: name.to_owned() });
+            return Err(GraphError::DuplicateName {
+                name: name.to_owned(),
+            });
         }
         let n_ports = match element.ports() {
             Ports::Fixed(p) => p.len(),
             Ports::Any => 0,
         };
-        let id = self.graph.add_node(Node { name: name.to_owned(), element }).index();
+        let id = self
+            .graph
+            .add_node(Node {
+                name: name.to_owned(),
+                element,
+            })
+            .index();
         self.ports.push(vec![None; n_ports]);
         Ok(id)
     }
@@ -54,7 +70,10 @@ impl BondGraph {
     /// The element called `name`.
     #[must_use]
     pub fn find(&self, name: &str) -> Option<ElementId> {
-        self.graph.node_indices().find(|&i| self.graph[i].name == name).map(NodeIndex::index)
+        self.graph
+            .node_indices()
+            .find(|&i| self.graph[i].name == name)
+            .map(NodeIndex::index)
     }
 
     /// Element by id.
@@ -96,7 +115,9 @@ impl BondGraph {
     #[must_use]
     pub fn port_name(&self, id: ElementId, port: usize) -> String {
         match self.node(id).element.ports() {
-            Ports::Fixed(p) => p.get(port).map_or_else(|| port.to_string(), |s| s.name.clone()),
+            Ports::Fixed(p) => p
+                .get(port)
+                .map_or_else(|| port.to_string(), |s| s.name.clone()),
             Ports::Any => port.to_string(),
         }
     }
@@ -105,16 +126,23 @@ impl BondGraph {
     pub fn port_index(&self, id: ElementId, port: &str) -> Result<usize, GraphError> {
         let node = self.node(id);
         match node.element.ports() {
-            Ports::Fixed(p) => p.iter().position(|s| s.name == port).ok_or_else(|| GraphError::NoSuchPort {
-                element: node.name.clone(),
-                kind: node.element.kind().to_owned(),
-                port: port.to_owned(),
-                available: if p.is_empty() {
-                    "(none: it is a signal block)".into()
-                } else {
-                    p.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ")
-                },
-            }),
+            Ports::Fixed(p) => {
+                p.iter()
+                    .position(|s| s.name == port)
+                    .ok_or_else(|| GraphError::NoSuchPort {
+                        element: node.name.clone(),
+                        kind: node.element.kind().to_owned(),
+                        port: port.to_owned(),
+                        available: if p.is_empty() {
+                            "(none: it is a signal block)".into()
+                        } else {
+                            p.iter()
+                                .map(|s| s.name.as_str())
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        },
+                    })
+            }
             Ports::Any => Err(GraphError::NoSuchPort {
                 element: node.name.clone(),
                 kind: node.element.kind().to_owned(),
@@ -124,25 +152,45 @@ impl BondGraph {
         }
     }
 
-    fn claim(&mut self, id: ElementId, port: Option<usize>, bond: BondId) -> Result<usize, GraphError> {
+    fn claim(
+        &mut self,
+        id: ElementId,
+        port: Option<usize>,
+        bond: BondId,
+    ) -> Result<usize, GraphError> {
         let node = self.node(id);
         let (name, kind) = (node.name.clone(), node.element.kind().to_owned());
         let fixed = matches!(node.element.ports(), Ports::Fixed(_));
         let slots = &mut self.ports[id];
         let port = match (port, fixed) {
             (Some(p), true) => p,
-            (None, true) => slots
-                .iter()
-                .position(Option::is_none)
-                .ok_or(GraphError::NoFreePort { element: name.clone(), kind: kind.clone(), n_ports: slots.len() })?,
+            (None, true) => {
+                slots
+                    .iter()
+                    .position(Option::is_none)
+                    .ok_or(GraphError::NoFreePort {
+                        element: name.clone(),
+                        kind: kind.clone(),
+                        n_ports: slots.len(),
+                    })?
+            }
             (_, false) => {
                 slots.push(None);
                 slots.len() - 1
             }
         };
         match slots.get_mut(port) {
-            None => Err(GraphError::NoSuchPort { element: name, kind, port: port.to_string(), available: format!("0..{}", slots.len()) }),
-            Some(Some(_)) => Err(GraphError::PortInUse { element: name, kind, port: self.port_name(id, port) }),
+            None => Err(GraphError::NoSuchPort {
+                element: name,
+                kind,
+                port: port.to_string(),
+                available: format!("0..{}", slots.len()),
+            }),
+            Some(Some(_)) => Err(GraphError::PortInUse {
+                element: name,
+                kind,
+                port: self.port_name(id, port),
+            }),
             Some(slot) => {
                 *slot = Some(bond);
                 Ok(port)
@@ -152,14 +200,23 @@ impl BondGraph {
 
     /// Connect `from` to `to` with a bond whose half-arrow points at `to`. `None` as a port
     /// takes the element's next free port (junctions always get a new one).
-    pub fn connect(&mut self, from: (ElementId, Option<usize>), to: (ElementId, Option<usize>)) -> Result<BondId, GraphError> {
+    pub fn connect(
+        &mut self,
+        from: (ElementId, Option<usize>),
+        to: (ElementId, Option<usize>),
+    ) -> Result<BondId, GraphError> {
         let id = self.graph.edge_count();
         let name = format!("b{}", id + 1);
         self.connect_named(&name, from, to)
     }
 
     /// [`connect`](Self::connect) with a bond name of your choice.
-    pub fn connect_named(&mut self, name: &str, from: (ElementId, Option<usize>), to: (ElementId, Option<usize>)) -> Result<BondId, GraphError> {
+    pub fn connect_named(
+        &mut self,
+        name: &str,
+        from: (ElementId, Option<usize>),
+        to: (ElementId, Option<usize>),
+    ) -> Result<BondId, GraphError> {
         let id = self.graph.edge_count();
         let before = (self.ports[from.0].clone(), self.ports[to.0].clone());
         let fp = self.claim(from.0, from.1, id)?;
@@ -172,23 +229,38 @@ impl BondGraph {
         };
         let bond = Bond {
             name: name.to_owned(),
-            from: Endpoint { element: from.0, port: fp },
-            to: Endpoint { element: to.0, port: tp },
+            from: Endpoint {
+                element: from.0,
+                port: fp,
+            },
+            to: Endpoint {
+                element: to.0,
+                port: tp,
+            },
             dim: 0,
         };
-        self.graph.add_edge(NodeIndex::new(from.0), NodeIndex::new(to.0), bond);
+        self.graph
+            .add_edge(NodeIndex::new(from.0), NodeIndex::new(to.0), bond);
         Ok(id)
     }
 
     /// Connect by element names: `connect_names("src", "j")` is the model file's `"src -> j"`.
     pub fn connect_names(&mut self, from: &str, to: &str) -> Result<BondId, GraphError> {
-        let f = self.find(from).ok_or_else(|| GraphError::UnknownElement { name: from.to_owned() })?;
-        let t = self.find(to).ok_or_else(|| GraphError::UnknownElement { name: to.to_owned() })?;
+        let f = self.find(from).ok_or_else(|| GraphError::UnknownElement {
+            name: from.to_owned(),
+        })?;
+        let t = self.find(to).ok_or_else(|| GraphError::UnknownElement {
+            name: to.to_owned(),
+        })?;
         self.connect((f, None), (t, None))
     }
 
     /// Replace element `id` by one of the same kind, ports and states (a parameter switch).
-    pub fn replace(&mut self, id: ElementId, element: Box<dyn Element>) -> Result<Box<dyn Element>, GraphError> {
+    pub fn replace(
+        &mut self,
+        id: ElementId,
+        element: Box<dyn Element>,
+    ) -> Result<Box<dyn Element>, GraphError> {
         let node = &mut self.graph[NodeIndex::new(id)];
         check_same_shape(&node.name, node.element.as_ref(), element.as_ref())?;
         Ok(std::mem::replace(&mut node.element, element))
@@ -202,7 +274,9 @@ impl BondGraph {
         for id in 0..self.n_elements() {
             let node = self.node(id);
             if matches!(node.element.ports(), Ports::Any) && self.ports[id].is_empty() {
-                return Err(GraphError::EmptyJunction { element: node.name.clone() });
+                return Err(GraphError::EmptyJunction {
+                    element: node.name.clone(),
+                });
             }
             if let Some(p) = self.ports[id].iter().position(Option::is_none) {
                 return Err(GraphError::Unconnected {
@@ -225,7 +299,7 @@ impl BondGraph {
     fn infer_dims(&mut self) -> Result<(), GraphError> {
         let n = self.n_bonds();
         let mut dims: Vec<Option<usize>> = vec![None; n];
-        for b in 0..n {
+        for (b, dim) in dims.iter_mut().enumerate() {
             let bond = self.bond(b).clone();
             let (df, dt) = (self.fixed_dim(bond.from), self.fixed_dim(bond.to));
             match (df, dt) {
@@ -242,7 +316,7 @@ impl BondGraph {
                         ),
                     });
                 }
-                (a, c) => dims[b] = a.or(c),
+                (a, c) => *dim = a.or(c),
             }
         }
         // Spread through junctions and adaptive two-ports until nothing changes.
@@ -299,8 +373,17 @@ impl BondGraph {
     }
 }
 
-pub(crate) fn check_same_shape(name: &str, old: &dyn Element, new: &dyn Element) -> Result<(), GraphError> {
-    let err = |message: String| Err(GraphError::Replacement { element: name.to_owned(), message });
+pub(crate) fn check_same_shape(
+    name: &str,
+    old: &dyn Element,
+    new: &dyn Element,
+) -> Result<(), GraphError> {
+    let err = |message: String| {
+        Err(GraphError::Replacement {
+            element: name.to_owned(),
+            message,
+        })
+    };
     if old.kind() != new.kind() {
         return err(format!("kind {} differs from {}", new.kind(), old.kind()));
     }

@@ -58,7 +58,9 @@ pub mod simulate;
 
 pub use bond::{Bond, BondId, ElementId, Endpoint, PortCausality};
 pub use causality::{assign_causality, CausalGraph};
-pub use element::{CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Slot, Stage, StateSpec};
+pub use element::{
+    CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Slot, Stage, StateSpec,
+};
 pub use elements::*;
 pub use equations::{Probe, StateEquations, StateInfo};
 pub use error::{CausalityError, Error, GraphError, ParamError, SimulationError};

@@ -18,7 +18,9 @@
 use std::cell::{Cell, RefCell};
 use std::time::{Duration, Instant};
 
-use diffsol::{NalgebraLU, NalgebraMat, OdeBuilder, OdeEquations, OdeSolverMethod, OdeSolverStopReason, Op};
+use diffsol::{
+    NalgebraLU, NalgebraMat, OdeBuilder, OdeEquations, OdeSolverMethod, OdeSolverStopReason, Op,
+};
 
 use crate::bond::ElementId;
 use crate::element::Element;
@@ -65,7 +67,12 @@ impl Method {
         }
     }
     /// All methods.
-    pub const ALL: [Method; 4] = [Method::Bdf, Method::Esdirk34, Method::TrBdf2, Method::Tsit45];
+    pub const ALL: [Method; 4] = [
+        Method::Bdf,
+        Method::Esdirk34,
+        Method::TrBdf2,
+        Method::Tsit45,
+    ];
 }
 
 /// Simulation settings.
@@ -87,7 +94,14 @@ pub struct Settings {
 
 impl Default for Settings {
     fn default() -> Self {
-        Self { t_start: 0.0, t_end: 1.0, dt_out: 0.01, method: Method::Bdf, rtol: 1e-6, atol: 1e-8 }
+        Self {
+            t_start: 0.0,
+            t_end: 1.0,
+            dt_out: 0.01,
+            method: Method::Bdf,
+            rtol: 1e-6,
+            atol: 1e-8,
+        }
     }
 }
 
@@ -96,13 +110,22 @@ impl Settings {
     pub fn validate(&self) -> Result<(), SimulationError> {
         let bad = |m: String| Err(SimulationError::Settings(m));
         if !self.t_start.is_finite() || !self.t_end.is_finite() || self.t_end <= self.t_start {
-            return bad(format!("need finite t_start < t_end, got t_start = {}, t_end = {}", self.t_start, self.t_end));
+            return bad(format!(
+                "need finite t_start < t_end, got t_start = {}, t_end = {}",
+                self.t_start, self.t_end
+            ));
         }
         if !(self.dt_out.is_finite() && self.dt_out > 0.0) {
-            return bad(format!("dt_out must be finite and > 0, got {}", self.dt_out));
+            return bad(format!(
+                "dt_out must be finite and > 0, got {}",
+                self.dt_out
+            ));
         }
         if (self.t_end - self.t_start) / self.dt_out > 1e8 {
-            return bad(format!("dt_out = {} gives more than 1e8 output rows", self.dt_out));
+            return bad(format!(
+                "dt_out = {} gives more than 1e8 output rows",
+                self.dt_out
+            ));
         }
         if !(self.rtol.is_finite() && self.rtol > 0.0 && self.rtol < 1.0) {
             return bad(format!("rtol must be in (0, 1), got {}", self.rtol));
@@ -246,10 +269,21 @@ fn same_time(a: f64, b: f64) -> bool {
 ///
 /// # Returns
 /// An [`Outcome`] that always carries the rows computed, even when the run failed.
-pub fn simulate(eqs: &mut StateEquations, x0: &[f64], settings: &Settings, outputs: &[Output], mut events: Vec<Event>) -> Outcome {
-    let columns = std::iter::once("t".to_owned()).chain(outputs.iter().map(|o| o.name.clone())).collect();
+pub fn simulate(
+    eqs: &mut StateEquations,
+    x0: &[f64],
+    settings: &Settings,
+    outputs: &[Output],
+    mut events: Vec<Event>,
+) -> Outcome {
+    let columns = std::iter::once("t".to_owned())
+        .chain(outputs.iter().map(|o| o.name.clone()))
+        .collect();
     let mut out = Outcome {
-        trajectory: Trajectory { columns, rows: Vec::new() },
+        trajectory: Trajectory {
+            columns,
+            rows: Vec::new(),
+        },
         stats: Statistics::default(),
         t_final: settings.t_start,
         x_final: x0.to_vec(),
@@ -260,7 +294,11 @@ pub fn simulate(eqs: &mut StateEquations, x0: &[f64], settings: &Settings, outpu
         return out;
     }
     if x0.len() != eqs.n_states() {
-        out.error = Some(SimulationError::Settings(format!("initial state has {} values, the model {} states", x0.len(), eqs.n_states())));
+        out.error = Some(SimulationError::Settings(format!(
+            "initial state has {} values, the model {} states",
+            x0.len(),
+            eqs.n_states()
+        )));
         return out;
     }
     if let Some((i, v)) = x0.iter().enumerate().find(|(_, v)| !v.is_finite()) {
@@ -278,7 +316,9 @@ pub fn simulate(eqs: &mut StateEquations, x0: &[f64], settings: &Settings, outpu
     events.sort_by(|a, b| a.t.total_cmp(&b.t));
     let (t0, t_end) = (settings.t_start, settings.t_end);
     let n_out = ((t_end - t0) / settings.dt_out + 1e-9).floor() as usize;
-    let mut grid: Vec<f64> = (0..=n_out).map(|k| t0 + k as f64 * settings.dt_out).collect();
+    let mut grid: Vec<f64> = (0..=n_out)
+        .map(|k| t0 + k as f64 * settings.dt_out)
+        .collect();
     if grid.last().is_some_and(|&t| !same_time(t, t_end)) {
         grid.push(t_end);
     }
@@ -299,7 +339,13 @@ pub fn simulate(eqs: &mut StateEquations, x0: &[f64], settings: &Settings, outpu
         if out.error.is_some() {
             break;
         }
-        let mut rec = Recorder { eqs, outputs, grid: std::mem::take(&mut grid), next: 0, rows: std::mem::take(&mut rows) };
+        let mut rec = Recorder {
+            eqs,
+            outputs,
+            grid: std::mem::take(&mut grid),
+            next: 0,
+            rows: std::mem::take(&mut rows),
+        };
         // Rows due at the current time (after the events).
         rec.next = rec.rows.len();
         while rec.pending().is_some_and(|g| same_time(g, t)) {
@@ -336,7 +382,14 @@ pub fn simulate(eqs: &mut StateEquations, x0: &[f64], settings: &Settings, outpu
 type SegmentError = (f64, Vec<f64>, SimulationError);
 
 /// Integrate from `t` to `t_stop`, recording grid rows strictly before `t_stop`.
-fn run_segment(rec: &mut Recorder<'_>, settings: &Settings, t: f64, t_stop: f64, x: &[f64], stats: &mut Statistics) -> Result<Vec<f64>, SegmentError> {
+fn run_segment(
+    rec: &mut Recorder<'_>,
+    settings: &Settings,
+    t: f64,
+    t_stop: f64,
+    x: &[f64],
+    stats: &mut Statistics,
+) -> Result<Vec<f64>, SegmentError> {
     let eqs = rec.eqs;
     let n = x.len();
     let nominal: Vec<f64> = eqs.states().iter().map(|s| s.nominal).collect();
@@ -344,7 +397,13 @@ fn run_segment(rec: &mut Recorder<'_>, settings: &Settings, t: f64, t_stop: f64,
     let rhs_calls = Cell::new(0usize);
     let jac_calls = Cell::new(0usize);
     let bad: RefCell<Option<(f64, Vec<f64>)>> = RefCell::new(None);
-    let cache = RefCell::new(FdCache { x: vec![f64::NAN; n], t: f64::NAN, fx: vec![0.0; n], xp: vec![0.0; n], fxp: vec![0.0; n] });
+    let cache = RefCell::new(FdCache {
+        x: vec![f64::NAN; n],
+        t: f64::NAN,
+        fx: vec![0.0; n],
+        xp: vec![0.0; n],
+        fxp: vec![0.0; n],
+    });
     let rhs = |x: &[f64], _p: &[f64], t: f64, dx: &mut [f64]| {
         rhs_calls.set(rhs_calls.get() + 1);
         eqs.rhs(t, x, dx);
@@ -354,8 +413,15 @@ fn run_segment(rec: &mut Recorder<'_>, settings: &Settings, t: f64, t_stop: f64,
     };
     let jvp = |x: &[f64], _p: &[f64], t: f64, v: &[f64], jv: &mut [f64]| {
         let mut c = cache.borrow_mut();
-        let FdCache { x: cx, t: ct, fx, xp, fxp } = &mut *c;
-        if *ct != t || cx.as_slice() != x {
+        let FdCache {
+            x: cx,
+            t: ct,
+            fx,
+            xp,
+            fxp,
+        } = &mut *c;
+        if ct.to_bits() != t.to_bits() || cx.iter().zip(x).any(|(a, b)| a.to_bits() != b.to_bits())
+        {
             eqs.rhs(t, x, fx);
             jac_calls.set(jac_calls.get() + 1);
             cx.copy_from_slice(x);
@@ -366,7 +432,12 @@ fn run_segment(rec: &mut Recorder<'_>, settings: &Settings, t: f64, t_stop: f64,
             jv.iter_mut().for_each(|j| *j = 0.0);
             return;
         }
-        let scale = x.iter().zip(v).zip(&nominal).filter(|((_, vj), _)| **vj != 0.0).fold(0.0f64, |m, ((xj, _), s)| m.max(xj.abs()).max(*s));
+        let scale = x
+            .iter()
+            .zip(v)
+            .zip(&nominal)
+            .filter(|((_, vj), _)| **vj != 0.0)
+            .fold(0.0f64, |m, ((xj, _), s)| m.max(xj.abs()).max(*s));
         let sigma = f64::EPSILON.sqrt() * scale / vmax;
         for k in 0..x.len() {
             xp[k] = x[k] + sigma * v[k];
@@ -394,17 +465,37 @@ fn run_segment(rec: &mut Recorder<'_>, settings: &Settings, t: f64, t_stop: f64,
     problem.ode_options.max_nonlinear_solver_failures = usize::MAX / 2;
     problem.ode_options.max_error_test_failures = 100;
     let result = match settings.method {
-        Method::Bdf => problem.bdf::<LS>().map_err(|e| e.to_string()).map(|s| drive(s, rec, t_stop, &bad, stats)),
-        Method::Esdirk34 => problem.esdirk34::<LS>().map_err(|e| e.to_string()).map(|s| drive(s, rec, t_stop, &bad, stats)),
-        Method::TrBdf2 => problem.tr_bdf2::<LS>().map_err(|e| e.to_string()).map(|s| drive(s, rec, t_stop, &bad, stats)),
-        Method::Tsit45 => problem.tsit45().map_err(|e| e.to_string()).map(|s| drive(s, rec, t_stop, &bad, stats)),
+        Method::Bdf => problem
+            .bdf::<LS>()
+            .map_err(|e| e.to_string())
+            .map(|s| drive(s, rec, t_stop, &bad, stats)),
+        Method::Esdirk34 => problem
+            .esdirk34::<LS>()
+            .map_err(|e| e.to_string())
+            .map(|s| drive(s, rec, t_stop, &bad, stats)),
+        Method::TrBdf2 => problem
+            .tr_bdf2::<LS>()
+            .map_err(|e| e.to_string())
+            .map(|s| drive(s, rec, t_stop, &bad, stats)),
+        Method::Tsit45 => problem
+            .tsit45()
+            .map_err(|e| e.to_string())
+            .map(|s| drive(s, rec, t_stop, &bad, stats)),
     };
     stats.rhs_evals += rhs_calls.get();
     stats.jac_rhs_evals += jac_calls.get();
     stats.jac_evals += problem.eqn.rhs().statistics().number_of_matrix_evals;
     match result {
         Ok(r) => r,
-        Err(message) => Err((t, x.to_vec(), SimulationError::Solver { t, message, culprit: String::new() })),
+        Err(message) => Err((
+            t,
+            x.to_vec(),
+            SimulationError::Solver {
+                t,
+                message,
+                culprit: String::new(),
+            },
+        )),
     }
 }
 
@@ -419,11 +510,20 @@ struct FdCache {
 fn culprit(eqs: &StateEquations, bad: &RefCell<Option<(f64, Vec<f64>)>>) -> String {
     bad.borrow()
         .as_ref()
-        .and_then(|(t, x)| eqs.first_non_finite(*t, x).map(|c| format!("; first non-finite value at t = {t:.9} s: {c}")))
+        .and_then(|(t, x)| {
+            eqs.first_non_finite(*t, x)
+                .map(|c| format!("; first non-finite value at t = {t:.9} s: {c}"))
+        })
         .unwrap_or_default()
 }
 
-fn drive<'a, Eqn, S>(mut s: S, rec: &mut Recorder<'_>, t_stop: f64, bad: &RefCell<Option<(f64, Vec<f64>)>>, stats: &mut Statistics) -> Result<Vec<f64>, SegmentError>
+fn drive<'a, Eqn, S>(
+    mut s: S,
+    rec: &mut Recorder<'_>,
+    t_stop: f64,
+    bad: &RefCell<Option<(f64, Vec<f64>)>>,
+    stats: &mut Statistics,
+) -> Result<Vec<f64>, SegmentError>
 where
     Eqn: OdeEquations<T = f64, V = diffsol::NalgebraVec<f64>> + 'a,
     S: OdeSolverMethod<'a, Eqn>,
@@ -443,7 +543,15 @@ where
     };
     if let Err(e) = s.set_stop_time(t_stop) {
         let (t, x) = state_of(&s);
-        return Err((t, x, SimulationError::Solver { t, message: e.to_string(), culprit: String::new() }));
+        return Err((
+            t,
+            x,
+            SimulationError::Solver {
+                t,
+                message: e.to_string(),
+                culprit: String::new(),
+            },
+        ));
     }
     loop {
         let step = s.step();
@@ -451,7 +559,15 @@ where
         match step {
             Err(e) => {
                 finish(&s, stats);
-                return Err((t, x, SimulationError::Solver { t, message: e.to_string(), culprit: culprit(eqs, bad) }));
+                return Err((
+                    t,
+                    x,
+                    SimulationError::Solver {
+                        t,
+                        message: e.to_string(),
+                        culprit: culprit(eqs, bad),
+                    },
+                ));
             }
             Ok(reason) => {
                 if let Some(i) = x.iter().position(|v| !v.is_finite()) {
@@ -477,7 +593,15 @@ where
                             Ok(y) => rec.record(tg, y.batch_as_slice(0)),
                             Err(e) => {
                                 finish(&s, stats);
-                                return Err((t, x, SimulationError::Solver { t, message: format!("interpolation at t = {tg}: {e}"), culprit: String::new() }));
+                                return Err((
+                                    t,
+                                    x,
+                                    SimulationError::Solver {
+                                        t,
+                                        message: format!("interpolation at t = {tg}: {e}"),
+                                        culprit: String::new(),
+                                    },
+                                ));
                             }
                         }
                     }

@@ -22,14 +22,22 @@ fn rigidly_coupled_inertias_are_derivative_causality() {
     let err = assign_causality(g).unwrap_err();
     let text = err.to_string();
     match &err {
-        Error::Causality(CausalityError::Derivative { element, kind, bond, .. }) => {
+        Error::Causality(CausalityError::Derivative {
+            element,
+            kind,
+            bond,
+            ..
+        }) => {
             assert!(element == "wheel" || element == "axle", "element {element}");
             assert_eq!(kind, "I");
             assert!(bond == "b2" || bond == "b3", "bond {bond}");
         }
         other => panic!("expected derivative causality, got {other:?}"),
     }
-    assert!(text.contains("wheel") && text.contains("axle"), "message must name both inertias: {text}");
+    assert!(
+        text.contains("wheel") && text.contains("axle"),
+        "message must name both inertias: {text}"
+    );
     assert!(text.contains("rigidly coupled inertias"), "hint: {text}");
 }
 
@@ -44,7 +52,10 @@ fn parallel_capacitors_are_derivative_causality() {
     bond_all(&mut g, &[("flow", "p"), ("p", "tank_a"), ("p", "tank_b")]);
     let err = assign_causality(g).unwrap_err();
     let text = err.to_string();
-    assert!(matches!(&err, Error::Causality(CausalityError::Derivative { kind, .. }) if kind == "C"), "{err:?}");
+    assert!(
+        matches!(&err, Error::Causality(CausalityError::Derivative { kind, .. }) if kind == "C"),
+        "{err:?}"
+    );
     assert!(text.contains("tank_a") && text.contains("tank_b"), "{text}");
 }
 
@@ -66,8 +77,14 @@ fn inertias_rigidly_coupled_through_a_transformer_are_derivative_causality() {
     g.connect((j2, None), (m2, Some(0))).unwrap();
     let err = assign_causality(g).unwrap_err();
     let text = err.to_string();
-    assert!(matches!(&err, Error::Causality(CausalityError::Derivative { kind, .. }) if kind == "I"), "{err:?}");
-    assert!(text.contains("m1") && text.contains("m2") && text.contains("lever"), "{text}");
+    assert!(
+        matches!(&err, Error::Causality(CausalityError::Derivative { kind, .. }) if kind == "I"),
+        "{err:?}"
+    );
+    assert!(
+        text.contains("m1") && text.contains("m2") && text.contains("lever"),
+        "{text}"
+    );
 }
 
 /// Two effort sources on one 0-junction impose the same effort: a causal conflict.
@@ -78,7 +95,10 @@ fn two_effort_sources_on_a_zero_junction_conflict() {
     g.add("battery", EffortSource::new(12.0)).unwrap();
     g.add("node", ZeroJunction).unwrap();
     g.add("load", Resistor::new(5.0).unwrap()).unwrap();
-    bond_all(&mut g, &[("supply", "node"), ("battery", "node"), ("node", "load")]);
+    bond_all(
+        &mut g,
+        &[("supply", "node"), ("battery", "node"), ("node", "load")],
+    );
     let err = assign_causality(g).unwrap_err();
     let text = err.to_string();
     match &err {
@@ -88,7 +108,10 @@ fn two_effort_sources_on_a_zero_junction_conflict() {
         }
         other => panic!("expected a conflict, got {other:?}"),
     }
-    assert!(text.contains("supply") && text.contains("battery") && text.contains("node"), "{text}");
+    assert!(
+        text.contains("supply") && text.contains("battery") && text.contains("node"),
+        "{text}"
+    );
 }
 
 /// Two flow sources on one 1-junction impose the same flow: a causal conflict.
@@ -99,15 +122,22 @@ fn two_flow_sources_on_a_one_junction_conflict() {
     g.add("pump_b", FlowSource::new(2.0)).unwrap();
     g.add("line", OneJunction).unwrap();
     g.add("orifice", Resistor::new(5.0).unwrap()).unwrap();
-    bond_all(&mut g, &[("pump_a", "line"), ("pump_b", "line"), ("line", "orifice")]);
+    bond_all(
+        &mut g,
+        &[("pump_a", "line"), ("pump_b", "line"), ("line", "orifice")],
+    );
     let err = assign_causality(g).unwrap_err();
-    assert!(matches!(&err, Error::Causality(CausalityError::Conflict { kind, .. }) if kind == "Sf"), "{err:?}");
+    assert!(
+        matches!(&err, Error::Causality(CausalityError::Conflict { kind, .. }) if kind == "Sf"),
+        "{err:?}"
+    );
 }
 
-/// Se → 1a (R1) → 0 (R2) → 1b (R3, C). With one state (q of C), the currents through R1 and
-/// R2 depend on each other whatever causality the resistors get: e0 = V − R1·i1 and
-/// i1 = e0/R2 + i3 (or the same loop through R1's conductance). SCAP leaves R1 in resistance
-/// causality and forces R2 into conductance; the plan has a cycle 1a → R1 → 1a → 0 → R2 → 0.
+/// Se → 1a (R1) → 0 (R2) → 1b (R3, C). With one state (q of C), the node effort e0 and the
+/// source current i1 depend on each other whatever causality the resistors get:
+/// e0 = V − R1·i1 and i1 = e0/R2 + (e0 − q/C)/R3. SCAP leaves R1 in resistance causality and
+/// forces R2 and R3 into conductance; the plan's cycle runs ja → R1 → ja → node → R2, jb, R3
+/// → node. The source (its effort depends on nothing) and C (a state) are not in it.
 #[test]
 fn resistive_loop_is_an_algebraic_loop_naming_its_elements() {
     let mut g = BondGraph::new();
@@ -119,22 +149,46 @@ fn resistive_loop_is_an_algebraic_loop_naming_its_elements() {
     g.add("jb", OneJunction).unwrap();
     g.add("R3", Resistor::new(3.0).unwrap()).unwrap();
     g.add("C", Capacitor::new(1.0, 0.0).unwrap()).unwrap();
-    bond_all(&mut g, &[("src", "ja"), ("ja", "R1"), ("ja", "node"), ("node", "R2"), ("node", "jb"), ("jb", "R3"), ("jb", "C")]);
-    let causal = assign_causality(g).expect("causality is assignable; the loop is in the equations");
+    bond_all(
+        &mut g,
+        &[
+            ("src", "ja"),
+            ("ja", "R1"),
+            ("ja", "node"),
+            ("node", "R2"),
+            ("node", "jb"),
+            ("jb", "R3"),
+            ("jb", "C"),
+        ],
+    );
+    let causal =
+        assign_causality(g).expect("causality is assignable; the loop is in the equations");
     let err = StateEquations::new(causal).unwrap_err();
     let text = err.to_string();
     match &err {
-        Error::Causality(CausalityError::AlgebraicLoop { elements, bonds, .. }) => {
-            for name in ["ja", "R1", "node", "R2"] {
-                assert!(elements.iter().any(|e| e == name), "loop {elements:?} lacks {name}");
+        Error::Causality(CausalityError::AlgebraicLoop {
+            elements, bonds, ..
+        }) => {
+            for name in ["ja", "R1", "node", "R2", "jb", "R3"] {
+                assert!(
+                    elements.iter().any(|e| e == name),
+                    "loop {elements:?} lacks {name}"
+                );
             }
             // A source's effort depends on nothing: it cannot be part of an algebraic loop.
-            assert!(!elements.iter().any(|e| e == "src"), "the source is not in the loop: {elements:?}");
-            // The storage branch is not in the loop either.
-            assert!(!elements.iter().any(|e| e == "C" || e == "R3" || e == "jb"), "{elements:?}");
-            // Bonds: ja–R1 (b2), ja–node (b3), node–R2 (b4).
-            for b in ["b2", "b3", "b4"] {
-                assert!(bonds.iter().any(|x| x == b), "loop bonds {bonds:?} lack {b}");
+            assert!(
+                !elements.iter().any(|e| e == "src"),
+                "the source is not in the loop: {elements:?}"
+            );
+            // Nor is the capacitor: its effort comes from its state.
+            assert!(!elements.iter().any(|e| e == "C"), "{elements:?}");
+            assert_eq!(elements.len(), 6, "{elements:?}");
+            // Bonds: ja–R1 (b2), ja–node (b3), node–R2 (b4), node–jb (b5), jb–R3 (b6).
+            for b in ["b2", "b3", "b4", "b5", "b6"] {
+                assert!(
+                    bonds.iter().any(|x| x == b),
+                    "loop bonds {bonds:?} lack {b}"
+                );
             }
         }
         other => panic!("expected an algebraic loop, got {other:?}"),
@@ -157,14 +211,29 @@ fn effort_source_beside_conductance_resistor_is_not_an_algebraic_loop() {
     bond_all(&mut g, &[("src", "j"), ("j", "R"), ("j", "C")]);
     let causal = assign_causality(g).unwrap();
     let r_id = causal.graph.find("R").unwrap();
-    assert_eq!(causal.element_causality(r_id), vec![PortCausality::FlowOut], "R in conductance causality");
-    let mut eqs = StateEquations::new(causal).unwrap_or_else(|e| panic!("false algebraic loop: {e}"));
+    assert_eq!(
+        causal.element_causality(r_id),
+        vec![PortCausality::FlowOut],
+        "R in conductance causality"
+    );
+    let mut eqs =
+        StateEquations::new(causal).unwrap_or_else(|e| panic!("false algebraic loop: {e}"));
     let x0 = eqs.initial_state();
     let outs = [output(&eqs, "C.q")];
-    let run = simulate(&mut eqs, &x0, &settings(Method::Bdf, 1.0, 0.01, 1e-10, 1e-13), &outs, vec![]);
+    let run = simulate(
+        &mut eqs,
+        &x0,
+        &settings(Method::Bdf, 1.0, 0.01, 1e-10, 1e-13),
+        &outs,
+        vec![],
+    );
     assert!(run.error.is_none(), "{:?}", run.error);
     let q_end = *col(&run.trajectory, "C.q").last().unwrap();
-    assert_abs_diff_eq!(q_end, c * v * (1.0 - (-1.0 / (r * c)).exp()), epsilon = 1e-7 * c * v);
+    assert_abs_diff_eq!(
+        q_end,
+        c * v * (1.0 - (-1.0 / (r * c)).exp()),
+        epsilon = 1e-7 * c * v
+    );
 }
 
 /// The dual: Sf → 0 (R, I). The source and the inertia both set their flows, so the
@@ -179,11 +248,18 @@ fn flow_source_beside_resistor_is_not_an_algebraic_loop() {
     g.add("R", Resistor::new(r).unwrap()).unwrap();
     g.add("L", Inertia::new(l, 0.0).unwrap()).unwrap();
     bond_all(&mut g, &[("src", "z"), ("z", "R"), ("z", "L")]);
-    let mut eqs = StateEquations::new(assign_causality(g).unwrap()).unwrap_or_else(|e| panic!("false algebraic loop: {e}"));
+    let mut eqs = StateEquations::new(assign_causality(g).unwrap())
+        .unwrap_or_else(|e| panic!("false algebraic loop: {e}"));
     // Current divider with an inductor: i_L' = (r/l)·(f − i_L), i_L(t) = f·(1 − e^{−rt/l}).
     let x0 = eqs.initial_state();
     let outs = [output(&eqs, "L.f")];
-    let run = simulate(&mut eqs, &x0, &settings(Method::Bdf, 0.5, 0.01, 1e-10, 1e-13), &outs, vec![]);
+    let run = simulate(
+        &mut eqs,
+        &x0,
+        &settings(Method::Bdf, 0.5, 0.01, 1e-10, 1e-13),
+        &outs,
+        vec![],
+    );
     assert!(run.error.is_none(), "{:?}", run.error);
     let i_end = *col(&run.trajectory, "L.f").last().unwrap();
     assert_abs_diff_eq!(i_end, f * (1.0 - (-r * 0.5 / l).exp()), epsilon = 1e-7 * f);
@@ -199,13 +275,36 @@ fn mass_spring_damper_gets_integral_causality() {
     g.add("mass", Inertia::new(2.0, 0.0).unwrap()).unwrap();
     g.add("spring", Capacitor::new(0.02, 0.0).unwrap()).unwrap();
     g.add("damper", Resistor::new(3.0).unwrap()).unwrap();
-    bond_all(&mut g, &[("force", "v"), ("v", "mass"), ("v", "spring"), ("v", "damper")]);
+    bond_all(
+        &mut g,
+        &[
+            ("force", "v"),
+            ("v", "mass"),
+            ("v", "spring"),
+            ("v", "damper"),
+        ],
+    );
     let causal = assign_causality(g).unwrap();
     let id = |n: &str| causal.graph.find(n).unwrap();
-    assert_eq!(causal.element_causality(id("force")), vec![PortCausality::EffortOut]);
-    assert_eq!(causal.element_causality(id("mass")), vec![PortCausality::FlowOut]);
-    assert_eq!(causal.element_causality(id("spring")), vec![PortCausality::EffortOut]);
-    assert_eq!(causal.element_causality(id("damper")), vec![PortCausality::EffortOut]);
+    assert_eq!(
+        causal.element_causality(id("force")),
+        vec![PortCausality::EffortOut]
+    );
+    assert_eq!(
+        causal.element_causality(id("mass")),
+        vec![PortCausality::FlowOut]
+    );
+    assert_eq!(
+        causal.element_causality(id("spring")),
+        vec![PortCausality::EffortOut]
+    );
+    assert_eq!(
+        causal.element_causality(id("damper")),
+        vec![PortCausality::EffortOut]
+    );
     use PortCausality::{EffortOut, FlowOut};
-    assert_eq!(causal.element_causality(id("v")), vec![FlowOut, EffortOut, FlowOut, FlowOut]);
+    assert_eq!(
+        causal.element_causality(id("v")),
+        vec![FlowOut, EffortOut, FlowOut, FlowOut]
+    );
 }

@@ -21,12 +21,35 @@ fn model(name: &str) -> (StateEquations, &'static [&'static str]) {
     match name {
         "mass-spring-damper" => (mass_spring_damper(1.0, 100.0, 0.4, 0.01), &["1"]),
         "series RLC" => (series_rlc(2.0, 1.0, 1.0, 0.25), &["1"]),
-        "lever" => (lever(Transformer::new(2.0).unwrap(), 3.0, 0.5, 40.0, 0.02, Some(0.3)), &["1", "0", "TF"]),
-        "lever, negative ratio" => (lever(Transformer::new(-0.7).unwrap(), 3.0, 0.5, 40.0, 0.02, None), &["1", "0", "TF"]),
+        "lever" => (
+            lever(
+                Transformer::new(2.0).unwrap(),
+                3.0,
+                0.5,
+                40.0,
+                0.02,
+                Some(0.3),
+            ),
+            &["1", "0", "TF"],
+        ),
+        "lever, negative ratio" => (
+            lever(Transformer::new(-0.7).unwrap(), 3.0, 0.5, 40.0, 0.02, None),
+            &["1", "0", "TF"],
+        ),
         "DC motor" => (dc_motor(12.0, 2.0, None, 0.5, 0.01, 0.1), &["1", "GY"]),
-        "DC motor with inductance" => (dc_motor(12.0, 2.0, Some(0.01), 0.5, 0.01, 0.1), &["1", "GY"]),
+        "DC motor with inductance" => (
+            dc_motor(12.0, 2.0, Some(0.01), 0.5, 0.01, 0.1),
+            &["1", "GY"],
+        ),
         "DC motor, modulated gyrator" => (
-            dc_motor(12.0, 2.0, Some(0.01), Param::modulated(vec!["J.p".into()], |t, u| 0.5 + 0.1 * (t + u[0]).sin()), 0.01, 0.1),
+            dc_motor(
+                12.0,
+                2.0,
+                Some(0.01),
+                Param::modulated(vec!["J.p".into()], |t, u| 0.5 + 0.1 * (t + u[0]).sin()),
+                0.01,
+                0.1,
+            ),
             &["1", "MGY"],
         ),
         "modulated lever" => (modulated_lever(Some(0.2)), &["1", "0", "MTF"]),
@@ -37,7 +60,12 @@ fn model(name: &str) -> (StateEquations, &'static [&'static str]) {
 
 /// Evaluate at (t, x) and check every conservative element. Returns how many elements were
 /// checked with a non-zero power scale.
-fn check_power(name: &str, eqs: &StateEquations, t: f64, x: &[f64]) -> Result<usize, TestCaseError> {
+fn check_power(
+    name: &str,
+    eqs: &StateEquations,
+    t: f64,
+    x: &[f64],
+) -> Result<usize, TestCaseError> {
     eqs.evaluate(t, x);
     let g = eqs.graph();
     let mut nontrivial = 0;
@@ -47,10 +75,18 @@ fn check_power(name: &str, eqs: &StateEquations, t: f64, x: &[f64]) -> Result<us
             continue;
         }
         let (p, scale) = (eqs.power_into(id), eqs.power_scale(id));
-        prop_assert!(p.is_finite() && scale.is_finite(), "{name}: `{}` power {p}, scale {scale}", node.name);
+        prop_assert!(
+            p.is_finite() && scale.is_finite(),
+            "{name}: `{}` power {p}, scale {scale}",
+            node.name
+        );
         if scale == 0.0 {
             // Nothing flows: the balance must be exactly zero.
-            prop_assert!(p == 0.0, "{name}: `{}` takes in {p} with every port power zero", node.name);
+            prop_assert!(
+                p == 0.0,
+                "{name}: `{}` takes in {p} with every port power zero",
+                node.name
+            );
         } else {
             prop_assert!(p.abs() <= REL_TOL * scale, "{name}: `{}` ({}) takes in {p:e}, scale {scale:e}, relative {:e} at t = {t}, x = {x:?}", node.name, node.element.kind(), p / scale);
             nontrivial += 1;
@@ -61,7 +97,9 @@ fn check_power(name: &str, eqs: &StateEquations, t: f64, x: &[f64]) -> Result<us
 
 /// A state vector for `eqs` from random unit numbers, each scaled by `magnitude`.
 fn state_from(eqs: &StateEquations, unit: &[f64], magnitude: f64) -> Vec<f64> {
-    (0..eqs.n_states()).map(|i| magnitude * unit[i % unit.len()]).collect()
+    (0..eqs.n_states())
+        .map(|i| magnitude * unit[i % unit.len()])
+        .collect()
 }
 
 /// Task 6 for one model: the kinds it is meant to exercise are there, something carries
@@ -71,17 +109,34 @@ fn power_property(name: &str) {
     let (eqs, kinds) = model(name);
     let g = eqs.graph();
     for kind in kinds {
-        assert!((0..g.n_elements()).any(|id| g.node(id).element.kind() == *kind), "{name} has no {kind}");
+        assert!(
+            (0..g.n_elements()).any(|id| g.node(id).element.kind() == *kind),
+            "{name} has no {kind}"
+        );
     }
     let generic: Vec<f64> = (0..eqs.n_states()).map(|i| 0.3 + 0.1 * i as f64).collect();
     let checked = check_power(name, &eqs, 0.1, &generic).unwrap_or_else(|e| panic!("{e}"));
-    assert!(checked >= 1, "{name}: no element carries power at {generic:?}");
+    assert!(
+        checked >= 1,
+        "{name}: no element carries power at {generic:?}"
+    );
 
-    let mut runner = TestRunner::new(ProptestConfig { cases: 256, ..ProptestConfig::default() });
-    let strategy = (prop::collection::vec(-1.0f64..1.0, 7), prop_oneof![Just(1e-6f64), Just(0.5), Just(1.0), Just(1e3)], 0.0f64..10.0);
+    let mut runner = TestRunner::new(ProptestConfig {
+        cases: 256,
+        ..ProptestConfig::default()
+    });
+    let strategy = (
+        prop::collection::vec(-1.0f64..1.0, 7),
+        prop_oneof![Just(1e-6f64), Just(0.5), Just(1.0), Just(1e3)],
+        0.0f64..10.0,
+    );
     let result = runner.run(&strategy, |(unit, magnitude, t)| {
         // The modulated lever's ratio 1 + q must stay away from 0: keep q within ±0.5.
-        let magnitude = if name == "modulated lever" { magnitude.min(0.5) } else { magnitude };
+        let magnitude = if name == "modulated lever" {
+            magnitude.min(0.5)
+        } else {
+            magnitude
+        };
         let x = state_from(&eqs, &unit, magnitude);
         check_power(name, &eqs, t, &x).map(|_| ())
     });

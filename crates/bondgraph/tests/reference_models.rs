@@ -11,42 +11,98 @@ use common::*;
 
 /// Largest |a − b| over paired samples.
 fn max_abs_diff(a: impl IntoIterator<Item = f64>, b: impl IntoIterator<Item = f64>) -> f64 {
-    a.into_iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+    a.into_iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
 }
 
 /// m = 1, k = 100 (c = 1/k), r = 0.4, q0 = 0.01, no force: m·x'' + r·x' + k·x = 0 with
-/// α = r/2m = 0.2, ω0 = 10, ω_d = √(ω0² − α²). Position (spring.q) within 1e-6 of the
-/// amplitude (1e-8 absolute) at every output row over 10 s, for every method.
+/// α = r/2m = 0.2, ω0 = 10, ω_d = √(ω0² − α²). Position (spring.q) compared with the analytic
+/// solution at every output row (dt_out = 0.01) over 10 s (16 periods).
+///
+/// At rtol 1e-8, atol 1e-12 every method runs; BDF (orders 1–5) and Tsit45 (order 5) stay
+/// within 1e-6 of the amplitude (1e-8 absolute). ESDIRK34 (order 3) and TR-BDF2 (order 2)
+/// cannot at that tolerance: local error control lets the global error grow with the number
+/// of steps, and they measure 1.8e-6 and 7.9e-6 of the amplitude there (their errors shrink
+/// as tol^(3/4) and tol^(2/3) when atol is also lowered, so this is their order, not a
+/// defect). They are held to a bound 2.5× their measured error at rtol 1e-8, and to the 1e-6
+/// requirement at the tighter rtol that reaches it.
 #[test]
 fn mass_spring_damper_matches_analytic_for_every_method() {
     let (m, k, r, q0): (f64, f64, f64, f64) = (1.0, 100.0, 0.4, 0.01);
     let (alpha, omega0) = (r / (2.0 * m), (k / m).sqrt());
+    // (method, rtol, atol, bound on |x − x_exact| relative to q0)
+    let cases = [
+        (Method::Bdf, 1e-8, 1e-12, 1e-6),
+        (Method::Esdirk34, 1e-8, 1e-12, 5e-6),
+        (Method::TrBdf2, 1e-8, 1e-12, 2e-5),
+        (Method::Tsit45, 1e-8, 1e-12, 1e-6),
+        (Method::Esdirk34, 1e-9, 1e-14, 1e-6),
+        (Method::TrBdf2, 1e-10, 1e-14, 1e-6),
+    ];
     for method in Method::ALL {
+        assert!(
+            cases.iter().any(|c| c.0 == method && c.1 == 1e-8),
+            "{} not run at rtol 1e-8",
+            method.name()
+        );
+    }
+    for (method, rtol, atol, bound) in cases {
         let mut eqs = mass_spring_damper(m, k, r, q0);
         let x0 = eqs.initial_state();
         let outs = [output(&eqs, "spring.q"), output(&eqs, "mass.p")];
-        let run = simulate(&mut eqs, &x0, &settings(method, 10.0, 0.01, 1e-8, 1e-12), &outs, vec![]);
-        eprintln!("mass-spring-damper, {}: {}", method.name(), run.stats);
-        assert!(run.error.is_none(), "{}: {:?}", method.name(), run.error);
+        let run = simulate(
+            &mut eqs,
+            &x0,
+            &settings(method, 10.0, 0.01, rtol, atol),
+            &outs,
+            vec![],
+        );
+        let name = format!("{} (rtol {rtol:e}, atol {atol:e})", method.name());
+        eprintln!("mass-spring-damper, {name}: {}", run.stats);
+        assert!(run.error.is_none(), "{name}: {:?}", run.error);
         let t = col(&run.trajectory, "t");
-        assert!(t.len() >= 1000, "{}: only {} rows", method.name(), t.len());
-        let exact_x: Vec<f64> = t.iter().map(|&t| underdamped(q0, 0.0, alpha, omega0, t).0).collect();
-        let exact_p: Vec<f64> = t.iter().map(|&t| m * underdamped(q0, 0.0, alpha, omega0, t).1).collect();
-        let err_x = max_abs_diff(col(&run.trajectory, "spring.q"), exact_x);
-        let err_p = max_abs_diff(col(&run.trajectory, "mass.p"), exact_p);
-        eprintln!("  max |x − x_exact| = {err_x:.3e}, max |p − p_exact| = {err_p:.3e}");
-        // 1e-6 relative to the amplitude q0 = 0.01; the momentum amplitude is ω0·m·q0 = 0.1.
-        assert!(err_x <= 1e-6 * q0, "{}: position error {err_x:e}", method.name());
-        assert!(err_p <= 1e-6 * omega0 * m * q0, "{}: momentum error {err_p:e}", method.name());
+        assert_eq!(t.len(), 1001, "{name}: rows");
+        let exact = |t: f64| underdamped(q0, 0.0, alpha, omega0, t);
+        let err_x = max_abs_diff(
+            col(&run.trajectory, "spring.q"),
+            t.iter().map(|&t| exact(t).0),
+        );
+        let err_p = max_abs_diff(
+            col(&run.trajectory, "mass.p"),
+            t.iter().map(|&t| m * exact(t).1),
+        );
+        eprintln!(
+            "  max |x − x_exact| = {err_x:.3e} ({:.2e} of q0), max |p − p_exact| = {err_p:.3e}",
+            err_x / q0
+        );
+        assert!(
+            err_x <= bound * q0,
+            "{name}: position error {err_x:e} > {:e}",
+            bound * q0
+        );
+        // The momentum amplitude is ω0·m·q0 = 0.1.
+        assert!(
+            err_p <= bound * omega0 * m * q0,
+            "{name}: momentum error {err_p:e}"
+        );
         // The final state is the analytic one too.
         assert_abs_diff_eq!(run.t_final, 10.0, epsilon = 1e-12);
-        assert_abs_diff_eq!(run.x_final[state_index(&eqs, "spring.q")], underdamped(q0, 0.0, alpha, omega0, 10.0).0, epsilon = 1e-6 * q0);
+        assert_abs_diff_eq!(
+            run.x_final[state_index(&eqs, "spring.q")],
+            exact(10.0).0,
+            epsilon = bound * q0
+        );
         assert!(run.stats.steps > 0 && run.stats.rhs_evals >= run.stats.steps);
     }
 }
 
 fn state_index(eqs: &StateEquations, name: &str) -> usize {
-    eqs.states().iter().position(|s| s.name == name).unwrap_or_else(|| panic!("no state {name}"))
+    eqs.states()
+        .iter()
+        .position(|s| s.name == name)
+        .unwrap_or_else(|| panic!("no state {name}"))
 }
 
 /// Series RLC, V = 2, R = 1, L = 1, C = 0.25, at rest: L·q'' + R·q' + q/C = V. With
@@ -58,21 +114,42 @@ fn series_rlc_capacitor_voltage_matches_step_response() {
     let (alpha, omega0) = (r / (2.0 * l), 1.0 / (l * c).sqrt());
     let mut eqs = series_rlc(v, r, l, c);
     let x0 = eqs.initial_state();
-    let outs = [output(&eqs, "C.e"), output(&eqs, "L.f"), output(&eqs, "R.e")];
-    let run = simulate(&mut eqs, &x0, &settings(Method::Bdf, 20.0, 0.01, 1e-10, 1e-13), &outs, vec![]);
+    let outs = [
+        output(&eqs, "C.e"),
+        output(&eqs, "L.f"),
+        output(&eqs, "R.e"),
+    ];
+    let run = simulate(
+        &mut eqs,
+        &x0,
+        &settings(Method::Bdf, 20.0, 0.01, 1e-10, 1e-13),
+        &outs,
+        vec![],
+    );
     assert!(run.error.is_none(), "{:?}", run.error);
     let t = col(&run.trajectory, "t");
-    let exact_vc = t.iter().map(|&t| v + underdamped(-c * v, 0.0, alpha, omega0, t).0 / c);
-    let exact_i = t.iter().map(|&t| underdamped(-c * v, 0.0, alpha, omega0, t).1);
+    let exact_vc = t
+        .iter()
+        .map(|&t| v + underdamped(-c * v, 0.0, alpha, omega0, t).0 / c);
+    let exact_i = t
+        .iter()
+        .map(|&t| underdamped(-c * v, 0.0, alpha, omega0, t).1);
     let err_vc = max_abs_diff(col(&run.trajectory, "C.e"), exact_vc);
     let err_i = max_abs_diff(col(&run.trajectory, "L.f"), exact_i);
     assert!(err_vc <= 1e-6 * v, "capacitor voltage error {err_vc:e}");
     assert!(err_i <= 1e-6 * v / r, "current error {err_i:e}");
     // Ohm's law on the resistor bond at every row, and the final value V.
-    for (e_r, i) in col(&run.trajectory, "R.e").into_iter().zip(col(&run.trajectory, "L.f")) {
+    for (e_r, i) in col(&run.trajectory, "R.e")
+        .into_iter()
+        .zip(col(&run.trajectory, "L.f"))
+    {
         assert_abs_diff_eq!(e_r, r * i, epsilon = 1e-12);
     }
-    assert_abs_diff_eq!(*col(&run.trajectory, "C.e").last().unwrap(), v, epsilon = 1e-3 * v);
+    assert_abs_diff_eq!(
+        *col(&run.trajectory, "C.e").last().unwrap(),
+        v,
+        epsilon = 1e-3 * v
+    );
 }
 
 /// Two masses coupled through a lever (TF, ratio n): `m1` on side 1, the lever's side 2
@@ -96,13 +173,31 @@ fn lever_two_masses_oscillate_at_reduced_mass_frequency_and_conserve_energy() {
     let x0 = eqs.initial_state();
     let e0 = eqs.stored_energy(&x0);
     assert_abs_diff_eq!(e0, 0.5 * k * q0 * q0, epsilon = 1e-15);
-    let outs = [output(&eqs, "spring.q"), output(&eqs, "m1.p"), output(&eqs, "m2.p"), output(&eqs, "m1.f"), output(&eqs, "m2.f")];
-    let run = simulate(&mut eqs, &x0, &settings(Method::Bdf, 3.0, 0.005, 1e-10, 1e-13), &outs, vec![]);
+    let outs = [
+        output(&eqs, "spring.q"),
+        output(&eqs, "m1.p"),
+        output(&eqs, "m2.p"),
+        output(&eqs, "m1.f"),
+        output(&eqs, "m2.f"),
+    ];
+    let run = simulate(
+        &mut eqs,
+        &x0,
+        &settings(Method::Bdf, 3.0, 0.005, 1e-10, 1e-13),
+        &outs,
+        vec![],
+    );
     assert!(run.error.is_none(), "{:?}", run.error);
     let tr = &run.trajectory;
     let t = col(tr, "t");
-    let err_q = max_abs_diff(col(tr, "spring.q"), t.iter().map(|&t| q0 * (omega * t).cos()));
-    assert!(err_q <= 1e-6 * q0, "spring deflection error {err_q:e} (ω = {omega})");
+    let err_q = max_abs_diff(
+        col(tr, "spring.q"),
+        t.iter().map(|&t| q0 * (omega * t).cos()),
+    );
+    assert!(
+        err_q <= 1e-6 * q0,
+        "spring deflection error {err_q:e} (ω = {omega})"
+    );
     let (p1, p2) = (col(tr, "m1.p"), col(tr, "m2.p"));
     let p_scale = (k * q0 * q0 * m2).sqrt(); // momentum scale √(2·E·m)
     for (a, b) in p1.iter().zip(&p2) {
@@ -120,7 +215,12 @@ fn lever_two_masses_oscillate_at_reduced_mass_frequency_and_conserve_energy() {
             x[i] = cols[j][row];
         }
         let e = eqs.stored_energy(&x);
-        assert!(((e - e0) / e0).abs() <= 1e-6, "energy drift {:e} at t = {}", (e - e0) / e0, t[row]);
+        assert!(
+            ((e - e0) / e0).abs() <= 1e-6,
+            "energy drift {:e} at t = {}",
+            (e - e0) / e0,
+            t[row]
+        );
     }
 }
 
@@ -134,20 +234,40 @@ fn dc_motor_speed_is_first_order_with_analytic_time_constant() {
     let tau = j * ra / (k * k + ra * b);
     let mut eqs = dc_motor(v, ra, None, k, j, b);
     let x0 = eqs.initial_state();
-    let outs = [output(&eqs, "J.f"), output(&eqs, "Ra.f"), output(&eqs, "gy.2.e")];
-    let run = simulate(&mut eqs, &x0, &settings(Method::Bdf, 1.0, 0.001, 1e-10, 1e-12), &outs, vec![]);
+    let outs = [
+        output(&eqs, "J.f"),
+        output(&eqs, "Ra.f"),
+        output(&eqs, "gy.2.e"),
+    ];
+    let run = simulate(
+        &mut eqs,
+        &x0,
+        &settings(Method::Bdf, 1.0, 0.001, 1e-10, 1e-12),
+        &outs,
+        vec![],
+    );
     assert!(run.error.is_none(), "{:?}", run.error);
     let tr = &run.trajectory;
     let t = col(tr, "t");
     let w = col(tr, "J.f");
-    let err = max_abs_diff(w.iter().copied(), t.iter().map(|&t| w_ss * (1.0 - (-t / tau).exp())));
+    let err = max_abs_diff(
+        w.iter().copied(),
+        t.iter().map(|&t| w_ss * (1.0 - (-t / tau).exp())),
+    );
     assert!(err <= 1e-7 * w_ss, "speed error {err:e}");
     // Steady speed after 1 s ≈ 22 τ.
     assert_abs_diff_eq!(*w.last().unwrap(), w_ss, epsilon = 1e-7 * w_ss);
     // The time constant read back from the trajectory at t ≈ τ, 2τ, 3τ.
-    for (&ti, &wi) in t.iter().zip(&w).filter(|(&ti, _)| ti > 0.5 * tau && ti < 3.0 * tau) {
+    for (&ti, &wi) in t
+        .iter()
+        .zip(&w)
+        .filter(|(&ti, _)| ti > 0.5 * tau && ti < 3.0 * tau)
+    {
         let tau_est = -ti / (1.0 - wi / w_ss).ln();
-        assert!(((tau_est - tau) / tau).abs() <= 1e-5, "τ estimate {tau_est} at t = {ti}, expected {tau}");
+        assert!(
+            ((tau_est - tau) / tau).abs() <= 1e-5,
+            "τ estimate {tau_est} at t = {ti}, expected {tau}"
+        );
     }
     // Gyrator law along the run: torque = k·i (i = current through R_a).
     for (torque, i) in col(tr, "gy.2.e").into_iter().zip(col(tr, "Ra.f")) {
@@ -164,10 +284,24 @@ fn dc_motor_with_inductance_reaches_the_same_steady_speed() {
     let mut eqs = dc_motor(v, ra, Some(la), k, j, b);
     let x0 = eqs.initial_state();
     let outs = [output(&eqs, "J.f"), output(&eqs, "La.f")];
-    let run = simulate(&mut eqs, &x0, &settings(Method::Bdf, 1.5, 0.01, 1e-10, 1e-12), &outs, vec![]);
+    let run = simulate(
+        &mut eqs,
+        &x0,
+        &settings(Method::Bdf, 1.5, 0.01, 1e-10, 1e-12),
+        &outs,
+        vec![],
+    );
     assert!(run.error.is_none(), "{:?}", run.error);
-    assert_abs_diff_eq!(*col(&run.trajectory, "J.f").last().unwrap(), w_ss, epsilon = 1e-6 * w_ss);
-    assert_abs_diff_eq!(*col(&run.trajectory, "La.f").last().unwrap(), i_ss, epsilon = 1e-6 * v / ra);
+    assert_abs_diff_eq!(
+        *col(&run.trajectory, "J.f").last().unwrap(),
+        w_ss,
+        epsilon = 1e-6 * w_ss
+    );
+    assert_abs_diff_eq!(
+        *col(&run.trajectory, "La.f").last().unwrap(),
+        i_ss,
+        epsilon = 1e-6 * v / ra
+    );
 }
 
 /// Lever with the modulated ratio n(q) = 1 + q (q = spring.q). An independent RK4 of
@@ -178,12 +312,28 @@ fn dc_motor_with_inductance_reaches_the_same_steady_speed() {
 fn modulated_lever_matches_reference_ode_and_conserves_energy() {
     let (m1, m2, k, q0) = (1.5, 0.5, 40.0, 0.05); // as in common::modulated_lever
     let mut eqs = modulated_lever(None);
-    assert_eq!(eqs.graph().node(eqs.graph().find("tf").unwrap()).element.kind(), "MTF");
+    assert_eq!(
+        eqs.graph()
+            .node(eqs.graph().find("tf").unwrap())
+            .element
+            .kind(),
+        "MTF"
+    );
     let x0 = eqs.initial_state();
     let e0 = eqs.stored_energy(&x0);
-    let outs = [output(&eqs, "m1.p"), output(&eqs, "spring.q"), output(&eqs, "m2.p")];
+    let outs = [
+        output(&eqs, "m1.p"),
+        output(&eqs, "spring.q"),
+        output(&eqs, "m2.p"),
+    ];
     let t_end = 2.0;
-    let run = simulate(&mut eqs, &x0, &settings(Method::Bdf, t_end, 0.01, 1e-10, 1e-13), &outs, vec![]);
+    let run = simulate(
+        &mut eqs,
+        &x0,
+        &settings(Method::Bdf, t_end, 0.01, 1e-10, 1e-13),
+        &outs,
+        vec![],
+    );
     assert!(run.error.is_none(), "{:?}", run.error);
     assert_eq!(run.trajectory.rows.len(), 201);
 
@@ -202,16 +352,29 @@ fn modulated_lever_matches_reference_ode_and_conserves_energy() {
             let k2 = f(std::array::from_fn(|i| y[i] + 0.5 * h * k1[i]));
             let k3 = f(std::array::from_fn(|i| y[i] + 0.5 * h * k2[i]));
             let k4 = f(std::array::from_fn(|i| y[i] + h * k3[i]));
-            y = std::array::from_fn(|i| y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]));
+            y = std::array::from_fn(|i| {
+                y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+            });
         }
         reference.push(y);
     }
     let tr = &run.trajectory;
     let p_scale = (2.0 * e0 * m1).sqrt();
-    for (name, i, scale) in [("m1.p", 0, p_scale), ("spring.q", 1, q0), ("m2.p", 2, p_scale)] {
+    for (name, i, scale) in [
+        ("m1.p", 0, p_scale),
+        ("spring.q", 1, q0),
+        ("m2.p", 2, p_scale),
+    ] {
         let err = max_abs_diff(col(tr, name), reference.iter().map(|r| r[i]));
-        assert!(err <= 1e-6 * scale, "{name}: error {err:e} against RK4 (scale {scale})");
+        assert!(
+            err <= 1e-6 * scale,
+            "{name}: error {err:e} against RK4 (scale {scale})"
+        );
     }
     let e_end = eqs.stored_energy(&run.x_final);
-    assert!(((e_end - e0) / e0).abs() <= 1e-6, "energy drift {:e}", (e_end - e0) / e0);
+    assert!(
+        ((e_end - e0) / e0).abs() <= 1e-6,
+        "energy drift {:e}",
+        (e_end - e0) / e0
+    );
 }

@@ -52,7 +52,15 @@ pub struct ModelError {
 
 impl ModelError {
     pub(crate) fn new(kind: ErrorKind, file: &str, message: impl Into<String>) -> Self {
-        Self { kind, file: file.to_owned(), line: None, col: None, element: None, message: message.into(), hint: None }
+        Self {
+            kind,
+            file: file.to_owned(),
+            line: None,
+            col: None,
+            element: None,
+            message: message.into(),
+            hint: None,
+        }
     }
     pub(crate) fn at(mut self, pos: Option<(usize, usize)>) -> Self {
         if let Some((l, c)) = pos {
@@ -98,6 +106,9 @@ impl std::error::Error for ModelError {}
 pub(crate) fn line_col(text: &str, offset: usize) -> (usize, usize) {
     let before = &text[..offset.min(text.len())];
     let line = before.matches('\n').count() + 1;
-    let col = before.rfind('\n').map_or(before.chars().count(), |i| before[i + 1..].chars().count()) + 1;
+    let col = before
+        .rfind('\n')
+        .map_or(before.chars().count(), |i| before[i + 1..].chars().count())
+        + 1;
     (line, col)
 }

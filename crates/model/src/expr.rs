@@ -124,11 +124,19 @@ impl Expr {
 
     /// Compile for fast repeated evaluation: every name becomes a constant (via `constant`) or
     /// an input slot (in the order of `inputs`).
-    pub fn compile(&self, constant: &dyn Fn(&str) -> Option<f64>, inputs: &[String]) -> Result<Compiled, String> {
+    pub fn compile(
+        &self,
+        constant: &dyn Fn(&str) -> Option<f64>,
+        inputs: &[String],
+    ) -> Result<Compiled, String> {
         Ok(Compiled(self.lower(constant, inputs)?))
     }
 
-    fn lower(&self, constant: &dyn Fn(&str) -> Option<f64>, inputs: &[String]) -> Result<Node, String> {
+    fn lower(
+        &self,
+        constant: &dyn Fn(&str) -> Option<f64>,
+        inputs: &[String],
+    ) -> Result<Node, String> {
         Ok(match self {
             Self::Num(v) => Node::Num(*v),
             Self::Name(n) if n == "pi" => Node::Num(std::f64::consts::PI),
@@ -142,10 +150,17 @@ impl Expr {
                 }
             }
             Self::Neg(a) => Node::Neg(Box::new(a.lower(constant, inputs)?)),
-            Self::Bin(op, a, b) => Node::Bin(*op, Box::new(a.lower(constant, inputs)?), Box::new(b.lower(constant, inputs)?)),
-            Self::Call(f, args) => {
-                Node::Call(f.clone(), args.iter().map(|a| a.lower(constant, inputs)).collect::<Result<_, _>>()?)
-            }
+            Self::Bin(op, a, b) => Node::Bin(
+                *op,
+                Box::new(a.lower(constant, inputs)?),
+                Box::new(b.lower(constant, inputs)?),
+            ),
+            Self::Call(f, args) => Node::Call(
+                f.clone(),
+                args.iter()
+                    .map(|a| a.lower(constant, inputs))
+                    .collect::<Result<_, _>>()?,
+            ),
         })
     }
 }
@@ -256,7 +271,10 @@ struct Parser<'a> {
 
 impl Parser<'_> {
     fn err(&self, message: String) -> ExprError {
-        ExprError { pos: self.i, message }
+        ExprError {
+            pos: self.i,
+            message,
+        }
     }
     fn ws(&mut self) {
         while self.i < self.c.len() && self.c[self.i].is_whitespace() {
@@ -326,7 +344,9 @@ impl Parser<'_> {
     }
     fn number(&mut self) -> Result<Expr, ExprError> {
         let start = self.i;
-        while self.i < self.c.len() && (self.c[self.i].is_ascii_digit() || self.c[self.i] == '.' || self.c[self.i] == '_') {
+        while self.i < self.c.len()
+            && (self.c[self.i].is_ascii_digit() || self.c[self.i] == '.' || self.c[self.i] == '_')
+        {
             self.i += 1;
         }
         if self.i < self.c.len() && (self.c[self.i] == 'e' || self.c[self.i] == 'E') {
@@ -343,12 +363,20 @@ impl Parser<'_> {
                 self.i = save;
             }
         }
-        let s: String = self.c[start..self.i].iter().filter(|&&c| c != '_').collect();
-        s.parse().map(Expr::Num).map_err(|_| ExprError { pos: start, message: format!("`{s}` is not a number") })
+        let s: String = self.c[start..self.i]
+            .iter()
+            .filter(|&&c| c != '_')
+            .collect();
+        s.parse().map(Expr::Num).map_err(|_| ExprError {
+            pos: start,
+            message: format!("`{s}` is not a number"),
+        })
     }
     fn name(&mut self) -> Result<Expr, ExprError> {
         let start = self.i;
-        while self.i < self.c.len() && (self.c[self.i].is_alphanumeric() || self.c[self.i] == '_' || self.c[self.i] == '.') {
+        while self.i < self.c.len()
+            && (self.c[self.i].is_alphanumeric() || self.c[self.i] == '_' || self.c[self.i] == '.')
+        {
             self.i += 1;
         }
         // an index suffix `[k]`
@@ -366,12 +394,18 @@ impl Parser<'_> {
         }
         let name: String = self.c[start..self.i].iter().collect();
         if name.ends_with('.') {
-            return Err(ExprError { pos: start, message: format!("`{name}` is not a valid name") });
+            return Err(ExprError {
+                pos: start,
+                message: format!("`{name}` is not a valid name"),
+            });
         }
         if self.peek() == Some('(') {
             let Some(&(_, arity)) = FUNCTIONS.iter().find(|(f, _)| *f == name) else {
                 let known: Vec<&str> = FUNCTIONS.iter().map(|(f, _)| *f).collect();
-                return Err(ExprError { pos: start, message: format!("unknown function `{name}`; known: {}", known.join(", ")) });
+                return Err(ExprError {
+                    pos: start,
+                    message: format!("unknown function `{name}`; known: {}", known.join(", ")),
+                });
             };
             self.i += 1;
             let mut args = Vec::new();
@@ -391,7 +425,14 @@ impl Parser<'_> {
                 None => !args.is_empty() && args.len() <= 8,
             };
             if !ok {
-                return Err(ExprError { pos: start, message: format!("`{name}` takes {} argument(s), got {}", arity.map_or("1 to 8".into(), |n| n.to_string()), args.len()) });
+                return Err(ExprError {
+                    pos: start,
+                    message: format!(
+                        "`{name}` takes {} argument(s), got {}",
+                        arity.map_or("1 to 8".into(), |n| n.to_string()),
+                        args.len()
+                    ),
+                });
             }
             return Ok(Expr::Call(name, args));
         }
@@ -405,7 +446,10 @@ mod tests {
     use super::*;
 
     fn ev(s: &str) -> f64 {
-        Expr::parse(s).unwrap().eval(&|n| (n == "k").then_some(4.0)).unwrap()
+        Expr::parse(s)
+            .unwrap()
+            .eval(&|n| (n == "k").then_some(4.0))
+            .unwrap()
     }
 
     #[test]
@@ -429,16 +473,27 @@ mod tests {
     #[test]
     fn errors_point_at_the_problem() {
         assert_eq!(Expr::parse("1 + ").unwrap_err().pos, 4);
-        assert!(Expr::parse("foo(1)").unwrap_err().message.contains("unknown function"));
-        assert!(Expr::parse("(1 + 2").unwrap_err().message.contains("missing `)`"));
-        assert!(Expr::parse("atan2(1)").unwrap_err().message.contains("takes 2"));
+        assert!(Expr::parse("foo(1)")
+            .unwrap_err()
+            .message
+            .contains("unknown function"));
+        assert!(Expr::parse("(1 + 2")
+            .unwrap_err()
+            .message
+            .contains("missing `)`"));
+        assert!(Expr::parse("atan2(1)")
+            .unwrap_err()
+            .message
+            .contains("takes 2"));
         assert!(Expr::parse("2 $ 3").is_err());
     }
 
     #[test]
     fn compiled_matches_interpreted() {
         let e = Expr::parse("k*x + sin(t)").unwrap();
-        let c = e.compile(&|n| (n == "k").then_some(4.0), &["x".into(), "t".into()]).unwrap();
+        let c = e
+            .compile(&|n| (n == "k").then_some(4.0), &["x".into(), "t".into()])
+            .unwrap();
         let want = e.eval(&|n| match n {
             "k" => Some(4.0),
             "x" => Some(0.5),

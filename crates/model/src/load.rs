@@ -7,7 +7,10 @@ use std::collections::{HashMap, HashSet};
 use std::ops::Range;
 use std::path::Path;
 
-use bondgraph::{assign_causality, BondGraph, CausalGraph, CausalityError, Element, Event, GraphError, Method, Output, Settings, StateEquations};
+use bondgraph::{
+    assign_causality, BondGraph, CausalGraph, CausalityError, Element, Event, GraphError, Method,
+    Output, Settings, StateEquations,
+};
 use indexmap::IndexMap;
 use serde::Deserialize;
 use toml::Spanned;
@@ -123,16 +126,27 @@ struct Source {
 }
 
 impl Source {
-    fn err(&self, kind: ErrorKind, span: Option<&Range<usize>>, message: impl Into<String>) -> ModelError {
+    fn err(
+        &self,
+        kind: ErrorKind,
+        span: Option<&Range<usize>>,
+        message: impl Into<String>,
+    ) -> ModelError {
         ModelError::new(kind, &self.file, message).at(span.map(|s| line_col(&self.text, s.start)))
     }
 
     fn element_pos(&self, name: &str) -> Option<(usize, usize)> {
-        self.elements.iter().find(|e| e.name == name).map(|e| line_col(&self.text, e.name_span.start))
+        self.elements
+            .iter()
+            .find(|e| e.name == name)
+            .map(|e| line_col(&self.text, e.name_span.start))
     }
 
     /// Evaluate every named parameter, with `set` overriding some expressions.
-    fn evaluate_parameters(&self, set: &IndexMap<String, RawValue>) -> Result<IndexMap<String, f64>, ModelError> {
+    fn evaluate_parameters(
+        &self,
+        set: &IndexMap<String, RawValue>,
+    ) -> Result<IndexMap<String, f64>, ModelError> {
         let mut exprs: IndexMap<String, RawValue> = self.param_exprs.clone();
         for (k, v) in set {
             exprs.insert(k.clone(), v.clone());
@@ -152,22 +166,48 @@ impl Source {
         Ok(ordered)
     }
 
-    fn eval_param(&self, name: &str, exprs: &IndexMap<String, RawValue>, values: &mut IndexMap<String, f64>, visiting: &mut Vec<String>) -> Result<f64, ModelError> {
+    fn eval_param(
+        &self,
+        name: &str,
+        exprs: &IndexMap<String, RawValue>,
+        values: &mut IndexMap<String, f64>,
+        visiting: &mut Vec<String>,
+    ) -> Result<f64, ModelError> {
         if let Some(v) = values.get(name) {
             return Ok(*v);
         }
         let raw = &exprs[name];
         if visiting.iter().any(|v| v == name) {
             return Err(self
-                .err(ErrorKind::BadParameter, Some(&raw.span), format!("parameter `{name}` depends on itself: {} -> {name}", visiting.join(" -> ")))
+                .err(
+                    ErrorKind::BadParameter,
+                    Some(&raw.span),
+                    format!(
+                        "parameter `{name}` depends on itself: {} -> {name}",
+                        visiting.join(" -> ")
+                    ),
+                )
                 .hint("break the cycle: give one of these parameters a number"));
         }
         let e = match &raw.value {
             toml::Value::Float(v) => Expr::Num(*v),
             toml::Value::Integer(i) => Expr::Num(*i as f64),
-            toml::Value::String(s) => Expr::parse(s).map_err(|e| self.err(ErrorKind::BadParameter, Some(&raw.span), format!("parameter `{name}` = \"{s}\": {e}")))?,
+            toml::Value::String(s) => Expr::parse(s).map_err(|e| {
+                self.err(
+                    ErrorKind::BadParameter,
+                    Some(&raw.span),
+                    format!("parameter `{name}` = \"{s}\": {e}"),
+                )
+            })?,
             other => {
-                return Err(self.err(ErrorKind::BadParameter, Some(&raw.span), format!("parameter `{name}` must be a number or an expression string, not {}", other.type_str())));
+                return Err(self.err(
+                    ErrorKind::BadParameter,
+                    Some(&raw.span),
+                    format!(
+                        "parameter `{name}` must be a number or an expression string, not {}",
+                        other.type_str()
+                    ),
+                ));
             }
         };
         visiting.push(name.to_owned());
@@ -178,28 +218,67 @@ impl Source {
             }
             if !exprs.contains_key(&n) {
                 return Err(self
-                    .err(ErrorKind::BadParameter, Some(&raw.span), format!("parameter `{name}` uses `{n}`, which is not a parameter"))
-                    .hint(format!("parameters may only use numbers and other parameters; known: {}", exprs.keys().cloned().collect::<Vec<_>>().join(", "))));
+                    .err(
+                        ErrorKind::BadParameter,
+                        Some(&raw.span),
+                        format!("parameter `{name}` uses `{n}`, which is not a parameter"),
+                    )
+                    .hint(format!(
+                        "parameters may only use numbers and other parameters; known: {}",
+                        exprs.keys().cloned().collect::<Vec<_>>().join(", ")
+                    )));
             }
             let v = self.eval_param(&n, exprs, values, visiting)?;
             deps.insert(n, v);
         }
         visiting.pop();
-        let v = e.eval(&|n| deps.get(n).copied()).map_err(|m| self.err(ErrorKind::BadParameter, Some(&raw.span), m))?;
+        let v = e
+            .eval(&|n| deps.get(n).copied())
+            .map_err(|m| self.err(ErrorKind::BadParameter, Some(&raw.span), m))?;
         if !v.is_finite() {
-            return Err(self.err(ErrorKind::BadParameter, Some(&raw.span), format!("parameter `{name}` is {v}, which is not finite")).hint("check for division by zero, a negative square root or a typo"));
+            return Err(self
+                .err(
+                    ErrorKind::BadParameter,
+                    Some(&raw.span),
+                    format!("parameter `{name}` is {v}, which is not finite"),
+                )
+                .hint("check for division by zero, a negative square root or a typo"));
         }
         values.insert(name.to_owned(), v);
         Ok(v)
     }
 
-    fn build_element(&self, def: &ElementDef, constants: &IndexMap<String, f64>) -> Result<(Box<dyn Element>, HashSet<String>), ModelError> {
+    fn build_element(
+        &self,
+        def: &ElementDef,
+        constants: &IndexMap<String, f64>,
+    ) -> Result<(Box<dyn Element>, HashSet<String>), ModelError> {
         let info = self.registry.get(&def.kind).ok_or_else(|| {
             let mut kinds: Vec<&str> = self.registry.kinds().map(|(k, _)| k).collect();
             kinds.sort_unstable();
-            let close: Vec<&str> = kinds.iter().copied().filter(|k| k.eq_ignore_ascii_case(&def.kind) || k.ends_with(&format!(".{}", def.kind))).collect();
-            let hint = if close.is_empty() { format!("known kinds: {}", kinds.join(", ")) } else { format!("did you mean {}? known kinds: {}", close.join(" or "), kinds.join(", ")) };
-            self.err(ErrorKind::UnknownKind, Some(&def.name_span), format!("unknown element kind `{}`", def.kind)).element(&def.name).hint(hint)
+            let close: Vec<&str> = kinds
+                .iter()
+                .copied()
+                .filter(|k| {
+                    k.eq_ignore_ascii_case(&def.kind) || k.ends_with(&format!(".{}", def.kind))
+                })
+                .collect();
+            let hint = if close.is_empty() {
+                format!("known kinds: {}", kinds.join(", "))
+            } else {
+                format!(
+                    "did you mean {}? known kinds: {}",
+                    close.join(" or "),
+                    kinds.join(", ")
+                )
+            };
+            self.err(
+                ErrorKind::UnknownKind,
+                Some(&def.name_span),
+                format!("unknown element kind `{}`", def.kind),
+            )
+            .element(&def.name)
+            .hint(hint)
         })?;
         let spec = ElementSpec {
             name: &def.name,
@@ -215,10 +294,23 @@ impl Source {
         let element = (info.build)(&spec)?;
         let (unused, asked) = spec.unused();
         if let Some(k) = unused.first() {
-            let close = asked.iter().find(|a| a.eq_ignore_ascii_case(k) || (a.len() > 1 && (k.starts_with(a.as_str()) || a.starts_with(k.as_str()))));
-            let takes = if asked.is_empty() { "it takes none".to_owned() } else { format!("it takes: {}", asked.join(", ")) };
+            let close = asked.iter().find(|a| {
+                a.eq_ignore_ascii_case(k)
+                    || (a.len() > 1 && (k.starts_with(a.as_str()) || a.starts_with(k.as_str())))
+            });
+            let takes = if asked.is_empty() {
+                "it takes none".to_owned()
+            } else {
+                format!("it takes: {}", asked.join(", "))
+            };
             let hint = close.map_or(takes.clone(), |c| format!("did you mean `{c}`? {takes}"));
-            return Err(spec.error(k, ErrorKind::ExtraParameter, format!("({}) has no parameter `{k}`", def.kind)).hint(hint));
+            return Err(spec
+                .error(
+                    k,
+                    ErrorKind::ExtraParameter,
+                    format!("({}) has no parameter `{k}`", def.kind),
+                )
+                .hint(hint));
         }
         Ok((element, spec.used_constants.into_inner()))
     }
@@ -247,7 +339,11 @@ pub struct Model {
 
 impl std::fmt::Debug for Model {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Model").field("file", &self.source.file).field("title", &self.title).field("n_states", &self.equations.n_states()).finish_non_exhaustive()
+        f.debug_struct("Model")
+            .field("file", &self.source.file)
+            .field("title", &self.title)
+            .field("n_states", &self.equations.n_states())
+            .finish_non_exhaustive()
     }
 }
 
@@ -281,17 +377,34 @@ fn syntax(file: &str, text: &str, e: &toml::de::Error) -> ModelError {
 
 fn valid_name(n: &str) -> bool {
     let mut c = n.chars();
-    c.next().is_some_and(|f| f.is_ascii_alphabetic() || f == '_') && c.all(|ch| ch.is_ascii_alphanumeric() || ch == '_')
+    c.next()
+        .is_some_and(|f| f.is_ascii_alphabetic() || f == '_')
+        && c.all(|ch| ch.is_ascii_alphanumeric() || ch == '_')
 }
 
 fn raw(v: &Spanned<toml::Value>) -> RawValue {
-    RawValue { value: v.get_ref().clone(), span: v.span() }
+    RawValue {
+        value: v.get_ref().clone(),
+        span: v.span(),
+    }
 }
 
-fn parse(file: &str, text: &str, registry: &Registry, overrides: &[String]) -> Result<Parsed, ModelError> {
+fn parse(
+    file: &str,
+    text: &str,
+    registry: &Registry,
+    overrides: &[String],
+) -> Result<Parsed, ModelError> {
     let text = crate::overrides::apply(file, text, overrides)?;
     let spec: FileSpec = toml::from_str(&text).map_err(|e| syntax(file, &text, &e))?;
-    let mut source = Source { file: file.to_owned(), text: text.clone(), registry: registry.clone(), param_exprs: IndexMap::new(), elements: Vec::new(), events: Vec::new() };
+    let mut source = Source {
+        file: file.to_owned(),
+        text: text.clone(),
+        registry: registry.clone(),
+        param_exprs: IndexMap::new(),
+        elements: Vec::new(),
+        events: Vec::new(),
+    };
     for (k, v) in &spec.parameters {
         if !valid_name(k.get_ref()) || RESERVED.contains(&k.get_ref().as_str()) {
             return Err(source
@@ -304,7 +417,15 @@ fn parse(file: &str, text: &str, registry: &Registry, overrides: &[String]) -> R
     for (name, table) in &spec.elements {
         let n = name.get_ref();
         if !valid_name(n) {
-            return Err(source.err(ErrorKind::Syntax, Some(&name.span()), format!("`{n}` cannot be an element name")).hint("element names are letters, digits and _ (starting with a letter), no dots"));
+            return Err(source
+                .err(
+                    ErrorKind::Syntax,
+                    Some(&name.span()),
+                    format!("`{n}` cannot be an element name"),
+                )
+                .hint(
+                    "element names are letters, digits and _ (starting with a letter), no dots",
+                ));
         }
         let mut params = IndexMap::new();
         let mut kind = None;
@@ -312,20 +433,52 @@ fn parse(file: &str, text: &str, registry: &Registry, overrides: &[String]) -> R
             if k.get_ref() == "kind" {
                 match v.get_ref() {
                     toml::Value::String(s) => kind = Some(s.clone()),
-                    _ => return Err(source.err(ErrorKind::Syntax, Some(&v.span()), "`kind` must be a string such as \"R\" or \"hydraulics.orifice\"").element(n)),
+                    _ => {
+                        return Err(source
+                            .err(
+                                ErrorKind::Syntax,
+                                Some(&v.span()),
+                                "`kind` must be a string such as \"R\" or \"hydraulics.orifice\"",
+                            )
+                            .element(n))
+                    }
                 }
             } else {
                 params.insert(k.get_ref().clone(), raw(v));
             }
         }
-        let kind = kind.ok_or_else(|| source.err(ErrorKind::Syntax, Some(&name.span()), "has no `kind`").element(n).hint("write e.g. `mass = { kind = \"I\", m = 1.0 }`"))?;
-        source.elements.push(ElementDef { name: n.clone(), kind, params, name_span: name.span(), used: HashSet::new() });
+        let kind = kind.ok_or_else(|| {
+            source
+                .err(ErrorKind::Syntax, Some(&name.span()), "has no `kind`")
+                .element(n)
+                .hint("write e.g. `mass = { kind = \"I\", m = 1.0 }`")
+        })?;
+        source.elements.push(ElementDef {
+            name: n.clone(),
+            kind,
+            params,
+            name_span: name.span(),
+            used: HashSet::new(),
+        });
     }
     for ev in &spec.events {
-        let set = ev.get_ref().set.iter().map(|(k, v)| (k.get_ref().clone(), raw(v))).collect();
-        source.events.push(EventDef { t: ev.get_ref().t, set, span: ev.span() });
+        let set = ev
+            .get_ref()
+            .set
+            .iter()
+            .map(|(k, v)| (k.get_ref().clone(), raw(v)))
+            .collect();
+        source.events.push(EventDef {
+            t: ev.get_ref().t,
+            set,
+            span: ev.span(),
+        });
     }
-    Ok(Parsed { spec, source, parameters })
+    Ok(Parsed {
+        spec,
+        source,
+        parameters,
+    })
 }
 
 fn build_graph(p: &mut Parsed) -> Result<BondGraph, ModelError> {
@@ -334,16 +487,30 @@ fn build_graph(p: &mut Parsed) -> Result<BondGraph, ModelError> {
         let def = p.source.elements[i].clone();
         let (element, used) = p.source.build_element(&def, &p.parameters)?;
         p.source.elements[i].used = used;
-        g.add_boxed(&def.name, element).map_err(|e| p.source.err(ErrorKind::Graph, Some(&def.name_span), e.to_string()).element(&def.name))?;
+        g.add_boxed(&def.name, element).map_err(|e| {
+            p.source
+                .err(ErrorKind::Graph, Some(&def.name_span), e.to_string())
+                .element(&def.name)
+        })?;
     }
     for (name, text) in &p.spec.bonds {
         let src = &p.source;
         let span = text.span();
-        let err = |kind, m: String| src.err(kind, Some(&span), format!("bond `{}`: {m}", name.get_ref()));
+        let err =
+            |kind, m: String| src.err(kind, Some(&span), format!("bond `{}`: {m}", name.get_ref()));
         if !valid_name(name.get_ref()) {
-            return Err(err(ErrorKind::Syntax, "bond names are letters, digits and _".into()));
+            return Err(err(
+                ErrorKind::Syntax,
+                "bond names are letters, digits and _".into(),
+            ));
         }
-        let (a, b) = text.get_ref().split_once("->").ok_or_else(|| err(ErrorKind::Syntax, format!("`{}` is not of the form \"from -> to\"", text.get_ref())).hint("the arrow points in the direction of positive power: \"source -> junction\""))?;
+        let (a, b) = text.get_ref().split_once("->").ok_or_else(|| {
+            err(
+                ErrorKind::Syntax,
+                format!("`{}` is not of the form \"from -> to\"", text.get_ref()),
+            )
+            .hint("the arrow points in the direction of positive power: \"source -> junction\"")
+        })?;
         let end = |s: &str| -> Result<(usize, Option<usize>), ModelError> {
             let s = s.trim();
             let (el, port) = match s.split_once('.') {
@@ -353,18 +520,24 @@ fn build_graph(p: &mut Parsed) -> Result<BondGraph, ModelError> {
             let id = g.find(el).ok_or_else(|| {
                 let mut known: Vec<&str> = src.elements.iter().map(|e| e.name.as_str()).collect();
                 known.sort_unstable();
-                err(ErrorKind::UnknownElement, format!("no element `{el}`")).hint(format!("elements are: {}", known.join(", ")))
+                err(ErrorKind::UnknownElement, format!("no element `{el}`"))
+                    .hint(format!("elements are: {}", known.join(", ")))
             })?;
             let port = match port {
                 None => None,
-                Some(p) => Some(g.port_index(id, p).map_err(|e| err(ErrorKind::Graph, e.to_string()).element(el))?),
+                Some(p) => Some(
+                    g.port_index(id, p)
+                        .map_err(|e| err(ErrorKind::Graph, e.to_string()).element(el))?,
+                ),
             };
             Ok((id, port))
         };
         let (from, to) = (end(a)?, end(b)?);
         g.connect_named(name.get_ref(), from, to).map_err(|e| {
             let hint = match &e {
-                GraphError::NoFreePort { element, .. } => format!("name the port: `{element}.<port>`, and check `{element}` is not bonded twice"),
+                GraphError::NoFreePort { element, .. } => format!(
+                    "name the port: `{element}.<port>`, and check `{element}` is not bonded twice"
+                ),
                 _ => "each port takes exactly one bond".into(),
             };
             err(ErrorKind::Graph, e.to_string()).hint(hint)
@@ -396,7 +569,8 @@ fn core_error(source: &Source, e: bondgraph::Error) -> ModelError {
         bondgraph::Error::Causality(c) => (
             ErrorKind::Causality,
             match c {
-                CausalityError::Derivative { element, .. } | CausalityError::Conflict { element, .. } => Some(element.clone()),
+                CausalityError::Derivative { element, .. }
+                | CausalityError::Conflict { element, .. } => Some(element.clone()),
                 CausalityError::AlgebraicLoop { elements, .. } => elements.first().cloned(),
                 _ => None,
             },
@@ -424,7 +598,11 @@ pub fn inspect(path: &Path, registry: &Registry, overrides: &[String]) -> Inspec
     let text = match std::fs::read_to_string(path) {
         Ok(t) => t,
         Err(e) => {
-            out.problems.push(ModelError::new(ErrorKind::Io, &file, format!("cannot read: {e}")));
+            out.problems.push(ModelError::new(
+                ErrorKind::Io,
+                &file,
+                format!("cannot read: {e}"),
+            ));
             return out;
         }
     };
@@ -445,10 +623,24 @@ pub fn inspect(path: &Path, registry: &Registry, overrides: &[String]) -> Inspec
     out.elements = (0..g.n_elements())
         .map(|i| {
             let n = g.node(i);
-            (n.name.clone(), n.element.kind().to_owned(), p.source.element_pos(&n.name).map_or(0, |x| x.0))
+            (
+                n.name.clone(),
+                n.element.kind().to_owned(),
+                p.source.element_pos(&n.name).map_or(0, |x| x.0),
+            )
         })
         .collect();
-    let plain: Vec<String> = g.bonds().map(|b| format!("{}: {} -> {}   (causality not assigned)", b.name, g.node(b.from.element).name, g.node(b.to.element).name)).collect();
+    let plain: Vec<String> = g
+        .bonds()
+        .map(|b| {
+            format!(
+                "{}: {} -> {}   (causality not assigned)",
+                b.name,
+                g.node(b.from.element).name,
+                g.node(b.to.element).name
+            )
+        })
+        .collect();
     let cg = match causal(&p, g) {
         Ok(c) => c,
         Err(e) => {
@@ -457,10 +649,16 @@ pub fn inspect(path: &Path, registry: &Registry, overrides: &[String]) -> Inspec
             return out;
         }
     };
-    out.bonds = (0..cg.graph.n_bonds()).map(|b| cg.describe_bond(b)).collect();
+    out.bonds = (0..cg.graph.n_bonds())
+        .map(|b| cg.describe_bond(b))
+        .collect();
     match StateEquations::new(cg) {
         Ok(eqs) => {
-            out.states = eqs.states().iter().map(|s| (s.name.clone(), s.initial)).collect();
+            out.states = eqs
+                .states()
+                .iter()
+                .map(|s| (s.name.clone(), s.initial))
+                .collect();
             out.order = eqs.order();
             if let Err(e) = finish(p, eqs) {
                 out.problems.push(e);
@@ -472,7 +670,11 @@ pub fn inspect(path: &Path, registry: &Registry, overrides: &[String]) -> Inspec
 }
 
 fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
-    let Parsed { spec, source, parameters } = p;
+    let Parsed {
+        spec,
+        source,
+        parameters,
+    } = p;
     // initial values
     let mut flat = Vec::new();
     flatten("", &spec.initial, &mut flat);
@@ -480,17 +682,40 @@ fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
         let v = match &value {
             toml::Value::Float(f) => Some(*f),
             toml::Value::Integer(i) => Some(*i as f64),
-            toml::Value::String(s) => Expr::parse(s).ok().and_then(|e| e.eval(&|n| parameters.get(n).copied()).ok()),
+            toml::Value::String(s) => Expr::parse(s)
+                .ok()
+                .and_then(|e| e.eval(&|n| parameters.get(n).copied()).ok()),
             _ => None,
         }
         .filter(|v| v.is_finite())
-        .ok_or_else(|| source.err(ErrorKind::BadParameter, Some(&span), format!("initial value of `{name}` must be a finite number or a constant expression")))?;
+        .ok_or_else(|| {
+            source.err(
+                ErrorKind::BadParameter,
+                Some(&span),
+                format!(
+                    "initial value of `{name}` must be a finite number or a constant expression"
+                ),
+            )
+        })?;
         eqs.set_initial(&name, v).map_err(|_| {
             let el = name.split('.').next().unwrap_or("");
-            let states: Vec<String> = eqs.states().iter().filter(|s| s.name.starts_with(&format!("{el}."))).map(|s| s.name.clone()).collect();
+            let states: Vec<String> = eqs
+                .states()
+                .iter()
+                .filter(|s| s.name.starts_with(&format!("{el}.")))
+                .map(|s| s.name.clone())
+                .collect();
             source
-                .err(ErrorKind::Settings, Some(&span), format!("[initial]: there is no state `{name}`"))
-                .hint(if states.is_empty() { "states are named `<element>.<state>`, e.g. `mass.p`, `spring.q`".to_owned() } else { format!("states of `{el}`: {}", states.join(", ")) })
+                .err(
+                    ErrorKind::Settings,
+                    Some(&span),
+                    format!("[initial]: there is no state `{name}`"),
+                )
+                .hint(if states.is_empty() {
+                    "states are named `<element>.<state>`, e.g. `mass.p`, `spring.q`".to_owned()
+                } else {
+                    format!("states of `{el}`: {}", states.join(", "))
+                })
         })?;
     }
     // settings
@@ -500,17 +725,32 @@ fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
         match v {
             None => Ok(default),
             Some(s) if s.get_ref().is_finite() => Ok(*s.get_ref()),
-            Some(s) => Err(source.err(ErrorKind::Settings, Some(&s.span()), format!("[simulation] {key} must be finite"))),
+            Some(s) => Err(source.err(
+                ErrorKind::Settings,
+                Some(&s.span()),
+                format!("[simulation] {key} must be finite"),
+            )),
         }
     };
     settings.t_start = num(&sim.t_start, 0.0, "t_start")?;
     settings.t_end = num(&sim.t_end, 1.0, "t_end")?;
-    settings.dt_out = num(&sim.dt_out, (settings.t_end - settings.t_start) / 100.0, "dt_out")?;
+    settings.dt_out = num(
+        &sim.dt_out,
+        (settings.t_end - settings.t_start) / 100.0,
+        "dt_out",
+    )?;
     settings.rtol = num(&sim.rtol, 1e-6, "rtol")?;
     settings.atol = num(&sim.atol, 1e-8, "atol")?;
     if let Some(s) = &sim.solver {
-        settings.method = Method::parse(s.get_ref())
-            .ok_or_else(|| source.err(ErrorKind::Settings, Some(&s.span()), format!("unknown solver `{}`", s.get_ref())).hint("solvers: bdf, esdirk34, tr-bdf2, tsit45"))?;
+        settings.method = Method::parse(s.get_ref()).ok_or_else(|| {
+            source
+                .err(
+                    ErrorKind::Settings,
+                    Some(&s.span()),
+                    format!("unknown solver `{}`", s.get_ref()),
+                )
+                .hint("solvers: bdf, esdirk34, tr-bdf2, tsit45")
+        })?;
     }
     if let Err(e) = settings.validate() {
         let span = sim.t_end.as_ref().map(Spanned::span);
@@ -520,7 +760,10 @@ fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
     let mut outputs = Vec::new();
     if spec.outputs.is_empty() {
         for (i, s) in eqs.states().iter().enumerate() {
-            outputs.push(Output { name: s.name.clone(), probe: bondgraph::Probe::State(i) });
+            outputs.push(Output {
+                name: s.name.clone(),
+                probe: bondgraph::Probe::State(i),
+            });
         }
     }
     for (col, name) in &spec.outputs {
@@ -533,16 +776,29 @@ fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
                 format!("`{el}` offers: {}", offers.join(", "))
             })
         })?;
-        outputs.push(Output { name: col.get_ref().clone(), probe });
+        outputs.push(Output {
+            name: col.get_ref().clone(),
+            probe,
+        });
     }
     // checks
     let mut checks = Vec::new();
     for c in &spec.check {
         let cs = c.get_ref();
         let parse_checked = |what: &str, text: &str| -> Result<Expr, ModelError> {
-            let e = Expr::parse(text).map_err(|e| source.err(ErrorKind::Settings, Some(&c.span()), format!("[[check]] {what} = \"{text}\": {e}")))?;
+            let e = Expr::parse(text).map_err(|e| {
+                source.err(
+                    ErrorKind::Settings,
+                    Some(&c.span()),
+                    format!("[[check]] {what} = \"{text}\": {e}"),
+                )
+            })?;
             for n in e.names() {
-                if n != "t" && n != "pi" && !parameters.contains_key(&n) && !outputs.iter().any(|o| o.name == n) {
+                if n != "t"
+                    && n != "pi"
+                    && !parameters.contains_key(&n)
+                    && !outputs.iter().any(|o| o.name == n)
+                {
                     return Err(source
                         .err(ErrorKind::Settings, Some(&c.span()), format!("[[check]] {what} uses `{n}`, which is neither `t`, a parameter nor an output column"))
                         .hint("name output columns in [outputs] with plain names (letters, digits, _) to use them in checks"));
@@ -553,24 +809,57 @@ fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
         let value_expr = parse_checked("value", &cs.value)?;
         let expected_expr = parse_checked("expected", &cs.expected)?;
         if !(cs.tol.is_finite() && cs.tol >= 0.0) {
-            return Err(source.err(ErrorKind::Settings, Some(&c.span()), format!("[[check]] tol must be finite and >= 0, got {}", cs.tol)));
+            return Err(source.err(
+                ErrorKind::Settings,
+                Some(&c.span()),
+                format!("[[check]] tol must be finite and >= 0, got {}", cs.tol),
+            ));
         }
-        checks.push(Check { value: cs.value.clone(), expected: cs.expected.clone(), tol: cs.tol, value_expr, expected_expr });
+        checks.push(Check {
+            value: cs.value.clone(),
+            expected: cs.expected.clone(),
+            tol: cs.tol,
+            value_expr,
+            expected_expr,
+        });
     }
-    let model = Model { title: spec.title, description: spec.description, x0: eqs.initial_state(), equations: eqs, settings, outputs, checks, parameters, source };
+    let model = Model {
+        title: spec.title,
+        description: spec.description,
+        x0: eqs.initial_state(),
+        equations: eqs,
+        settings,
+        outputs,
+        checks,
+        parameters,
+        source,
+    };
     // events must build now, so that their errors show at load time
     model.events()?;
     Ok(model)
 }
 
-fn flatten(prefix: &str, map: &SpannedMap<toml::Value>, out: &mut Vec<(String, toml::Value, Range<usize>)>) {
+fn flatten(
+    prefix: &str,
+    map: &SpannedMap<toml::Value>,
+    out: &mut Vec<(String, toml::Value, Range<usize>)>,
+) {
     for (k, v) in map {
-        let name = if prefix.is_empty() { k.get_ref().clone() } else { format!("{prefix}.{}", k.get_ref()) };
+        let name = if prefix.is_empty() {
+            k.get_ref().clone()
+        } else {
+            format!("{prefix}.{}", k.get_ref())
+        };
         flatten_value(&name, v.get_ref(), v.span(), out);
     }
 }
 
-fn flatten_value(name: &str, v: &toml::Value, span: Range<usize>, out: &mut Vec<(String, toml::Value, Range<usize>)>) {
+fn flatten_value(
+    name: &str,
+    v: &toml::Value,
+    span: Range<usize>,
+    out: &mut Vec<(String, toml::Value, Range<usize>)>,
+) {
     match v {
         toml::Value::Table(t) => {
             for (k, v) in t {
@@ -583,14 +872,26 @@ fn flatten_value(name: &str, v: &toml::Value, span: Range<usize>, out: &mut Vec<
 
 impl Model {
     /// Load a model file with the given element kinds and `--set` overrides.
-    pub fn load(path: &Path, registry: &Registry, overrides: &[String]) -> Result<Self, ModelError> {
+    pub fn load(
+        path: &Path,
+        registry: &Registry,
+        overrides: &[String],
+    ) -> Result<Self, ModelError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| ModelError::new(ErrorKind::Io, &file, format!("cannot read: {e}")).hint("check the path"))?;
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            ModelError::new(ErrorKind::Io, &file, format!("cannot read: {e}"))
+                .hint("check the path")
+        })?;
         Self::from_text(&file, &text, registry, overrides)
     }
 
     /// Load a model from text; `file` names it in errors.
-    pub fn from_text(file: &str, text: &str, registry: &Registry, overrides: &[String]) -> Result<Self, ModelError> {
+    pub fn from_text(
+        file: &str,
+        text: &str,
+        registry: &Registry,
+        overrides: &[String],
+    ) -> Result<Self, ModelError> {
         let mut p = parse(file, text, registry, overrides)?;
         let g = build_graph(&mut p)?;
         let cg = causal(&p, g)?;
@@ -620,29 +921,57 @@ impl Model {
         let mut events = Vec::new();
         for ev in defs {
             if !ev.t.is_finite() {
-                return Err(self.source.err(ErrorKind::Settings, Some(&ev.span), format!("event time {} is not finite", ev.t)));
+                return Err(self.source.err(
+                    ErrorKind::Settings,
+                    Some(&ev.span),
+                    format!("event time {} is not finite", ev.t),
+                ));
             }
             for (k, v) in &ev.set {
                 if !self.source.param_exprs.contains_key(k) {
                     return Err(self
                         .source
-                        .err(ErrorKind::Settings, Some(&v.span), format!("event at t = {}: `{k}` is not a parameter", ev.t))
-                        .hint(format!("events set names from [parameters]: {}", self.parameters.keys().cloned().collect::<Vec<_>>().join(", "))));
+                        .err(
+                            ErrorKind::Settings,
+                            Some(&v.span),
+                            format!("event at t = {}: `{k}` is not a parameter", ev.t),
+                        )
+                        .hint(format!(
+                            "events set names from [parameters]: {}",
+                            self.parameters
+                                .keys()
+                                .cloned()
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        )));
                 }
                 set.insert(k.clone(), v.clone());
             }
             let values = self.source.evaluate_parameters(&set)?;
-            let changed: HashSet<&String> = values.iter().filter(|(k, v)| current.get(*k) != Some(*v)).map(|(k, _)| k).collect();
+            let changed: HashSet<&String> = values
+                .iter()
+                .filter(|(k, v)| current.get(*k) != Some(*v))
+                .map(|(k, _)| k)
+                .collect();
             let mut replacements = Vec::new();
             for (id, def) in self.source.elements.iter().enumerate() {
                 if def.used.iter().any(|u| changed.contains(u)) {
                     let (el, _) = self.source.build_element(def, &values)?;
-                    self.equations.check_replacement(id, el.as_ref()).map_err(|e| self.source.err(ErrorKind::Settings, Some(&ev.span), e.to_string()).element(&def.name))?;
+                    self.equations
+                        .check_replacement(id, el.as_ref())
+                        .map_err(|e| {
+                            self.source
+                                .err(ErrorKind::Settings, Some(&ev.span), e.to_string())
+                                .element(&def.name)
+                        })?;
                     replacements.push((id, el));
                 }
             }
             current = values;
-            events.push(Event { t: ev.t, replacements });
+            events.push(Event {
+                t: ev.t,
+                replacements,
+            });
         }
         Ok(events)
     }
@@ -653,11 +982,19 @@ impl Model {
         let events = self.events()?;
         let has_events = !events.is_empty();
         let x0 = self.x0.clone();
-        let out = bondgraph::simulate(&mut self.equations, &x0, &self.settings, &self.outputs, events);
+        let out = bondgraph::simulate(
+            &mut self.equations,
+            &x0,
+            &self.settings,
+            &self.outputs,
+            events,
+        );
         if has_events {
             for (id, def) in self.source.elements.iter().enumerate() {
                 let (el, _) = self.source.build_element(def, &self.parameters)?;
-                self.equations.replace(id, el).map_err(|e| self.source.err(ErrorKind::Settings, None, e.to_string()))?;
+                self.equations
+                    .replace(id, el)
+                    .map_err(|e| self.source.err(ErrorKind::Settings, None, e.to_string()))?;
             }
         }
         Ok(out)
@@ -693,7 +1030,13 @@ impl Model {
                         worst = (err, t);
                     }
                 }
-                CheckResult { value: c.value.clone(), max_error: worst.0, t_worst: worst.1, tol: c.tol, passed: finite && worst.0 <= c.tol }
+                CheckResult {
+                    value: c.value.clone(),
+                    max_error: worst.0,
+                    t_worst: worst.1,
+                    tol: c.tol,
+                    passed: finite && worst.0 <= c.tol,
+                }
             })
             .collect()
     }

@@ -14,10 +14,14 @@ pub fn apply(file: &str, text: &str, overrides: &[String]) -> Result<String, Mod
     if overrides.is_empty() {
         return Ok(text.to_owned());
     }
-    let mut doc: DocumentMut = text.parse().map_err(|e: toml_edit::TomlError| ModelError::new(ErrorKind::Syntax, file, e.message().to_owned()))?;
+    let mut doc: DocumentMut = text.parse().map_err(|e: toml_edit::TomlError| {
+        ModelError::new(ErrorKind::Syntax, file, e.message().to_owned())
+    })?;
     for o in overrides {
         let err = |m: String| ModelError::new(ErrorKind::Override, file, format!("--set {o}: {m}"));
-        let (key, value) = o.split_once('=').ok_or_else(|| err("expected key=value".into()))?;
+        let (key, value) = o
+            .split_once('=')
+            .ok_or_else(|| err("expected key=value".into()))?;
         let path: Vec<&str> = key.trim().split('.').collect();
         if path.iter().any(|p| p.is_empty()) {
             return Err(err("empty key segment".into()));
@@ -38,13 +42,18 @@ type SetError = (String, Option<String>);
 
 fn set_path(item: &mut Item, path: &[&str], i: usize, value: Value) -> Result<(), SetError> {
     let seg = path[i];
-    let table = item.as_table_like_mut().ok_or_else(|| (format!("`{}` is not a table", path[..i].join(".")), None))?;
+    let table = item
+        .as_table_like_mut()
+        .ok_or_else(|| (format!("`{}` is not a table", path[..i].join(".")), None))?;
     let exists = table.get(seg).is_some();
     if i + 1 == path.len() {
         // New keys are allowed only where the file format has optional keys.
         if !exists && path[0] == "parameters" {
             let known: Vec<String> = table.iter().map(|(k, _)| k.to_owned()).collect();
-            return Err((format!("the model has no parameter `{seg}`"), Some(format!("parameters are: {}", known.join(", ")))));
+            return Err((
+                format!("the model has no parameter `{seg}`"),
+                Some(format!("parameters are: {}", known.join(", "))),
+            ));
         }
         if !exists && path[0] == "elements" && path.len() == 2 {
             return Err((format!("the model has no element `{seg}`"), None));
@@ -58,7 +67,9 @@ fn set_path(item: &mut Item, path: &[&str], i: usize, value: Value) -> Result<()
         }
         table.insert(seg, Item::Table(toml_edit::Table::new()));
     }
-    let next = table.get_mut(seg).ok_or_else(|| (format!("no `{seg}`"), None))?;
+    let next = table
+        .get_mut(seg)
+        .ok_or_else(|| (format!("no `{seg}`"), None))?;
     set_path(next, path, i + 1, value)
 }
 
@@ -75,11 +86,23 @@ mod tests {
 
     #[test]
     fn changes_values_and_keeps_lines() {
-        let out = apply("m.toml", MODEL, &["parameters.k=5".into(), "elements.mass.m=1/k".into(), "simulation.solver=esdirk34".into()]).unwrap();
+        let out = apply(
+            "m.toml",
+            MODEL,
+            &[
+                "parameters.k=5".into(),
+                "elements.mass.m=1/k".into(),
+                "simulation.solver=esdirk34".into(),
+            ],
+        )
+        .unwrap();
         assert!(out.contains("k = 5 # stiffness"), "{out}");
         assert!(out.contains("m = \"1/k\""), "{out}");
         assert!(out.contains("solver = \"esdirk34\""), "{out}");
-        assert_eq!(out.lines().position(|l| l.starts_with("mass")), MODEL.lines().position(|l| l.starts_with("mass")));
+        assert_eq!(
+            out.lines().position(|l| l.starts_with("mass")),
+            MODEL.lines().position(|l| l.starts_with("mass"))
+        );
     }
 
     #[test]

@@ -47,7 +47,8 @@ impl Registry {
 
     /// Register `kind`; a later registration of the same name replaces the earlier one.
     pub fn register(&mut self, kind: &str, summary: &'static str, build: BuildFn) {
-        self.kinds.insert(kind.to_owned(), KindInfo { build, summary });
+        self.kinds
+            .insert(kind.to_owned(), KindInfo { build, summary });
     }
 
     /// The kind called `kind`.
@@ -99,15 +100,22 @@ impl ElementSpec<'_> {
     /// A positioned error about parameter `key` (or the element if the key is absent).
     #[must_use]
     pub fn error(&self, key: &str, kind: ErrorKind, message: impl Into<String>) -> ModelError {
-        let span = self.params.get(key).map_or(self.name_span.start, |v| v.span.start);
-        ModelError::new(kind, self.file, message).at(Some(line_col(self.text, span))).element(self.name)
+        let span = self
+            .params
+            .get(key)
+            .map_or(self.name_span.start, |v| v.span.start);
+        ModelError::new(kind, self.file, message)
+            .at(Some(line_col(self.text, span)))
+            .element(self.name)
     }
 
     /// Turn an element constructor's [`ParamError`] into a positioned error.
     #[must_use]
     pub fn param_error(&self, e: &ParamError) -> ModelError {
         let key = match e {
-            ParamError::OutOfRange { param, .. } | ParamError::Shape { param, .. } => param.as_str(),
+            ParamError::OutOfRange { param, .. } | ParamError::Shape { param, .. } => {
+                param.as_str()
+            }
             _ => "",
         };
         self.error(key, ErrorKind::BadParameter, format!("({}) {e}", self.kind))
@@ -121,8 +129,12 @@ impl ElementSpec<'_> {
     }
 
     fn missing(&self, key: &str, what: &str) -> ModelError {
-        self.error(key, ErrorKind::MissingParameter, format!("({}) needs parameter `{key}` ({what})", self.kind))
-            .hint(format!("add `{key} = …` to element `{}`", self.name))
+        self.error(
+            key,
+            ErrorKind::MissingParameter,
+            format!("({}) needs parameter `{key}` ({what})", self.kind),
+        )
+        .hint(format!("add `{key} = …` to element `{}`", self.name))
     }
 
     /// Parse `key`'s value as an expression (a TOML number is a constant expression).
@@ -146,10 +158,23 @@ impl ElementSpec<'_> {
         }
         let v = e.eval(&|n| self.constants.get(n).copied()).map_err(|m| {
             self.error(key, ErrorKind::BadParameter, format!("`{key}`: {m}"))
-                .hint(format!("`{key}` must be constant: use numbers and names from [parameters] ({})", self.constants.keys().cloned().collect::<Vec<_>>().join(", ")))
+                .hint(format!(
+                    "`{key}` must be constant: use numbers and names from [parameters] ({})",
+                    self.constants
+                        .keys()
+                        .cloned()
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ))
         })?;
         if !v.is_finite() {
-            return Err(self.error(key, ErrorKind::BadParameter, format!("`{key}` evaluates to {v}, which is not finite")).hint("check for division by zero or a typo"));
+            return Err(self
+                .error(
+                    key,
+                    ErrorKind::BadParameter,
+                    format!("`{key}` evaluates to {v}, which is not finite"),
+                )
+                .hint("check for division by zero or a typo"));
         }
         Ok(v)
     }
@@ -192,7 +217,11 @@ impl ElementSpec<'_> {
         let (compiled, inputs) = self.compile(key, &e)?;
         if let Some(v) = compiled.constant() {
             if !v.is_finite() {
-                return Err(self.error(key, ErrorKind::BadParameter, format!("`{key}` evaluates to {v}, which is not finite")));
+                return Err(self.error(
+                    key,
+                    ErrorKind::BadParameter,
+                    format!("`{key}` evaluates to {v}, which is not finite"),
+                ));
             }
             return Ok(Param::Const(v));
         }
@@ -217,9 +246,19 @@ impl ElementSpec<'_> {
             }
         }
         if inputs.len() > bondgraph::element::MAX_PARAM_INPUTS {
-            return Err(self.error(key, ErrorKind::BadParameter, format!("`{key}` reads {} signals; at most {}", inputs.len(), bondgraph::element::MAX_PARAM_INPUTS)));
+            return Err(self.error(
+                key,
+                ErrorKind::BadParameter,
+                format!(
+                    "`{key}` reads {} signals; at most {}",
+                    inputs.len(),
+                    bondgraph::element::MAX_PARAM_INPUTS
+                ),
+            ));
         }
-        let c = e.compile(&|n| self.constants.get(n).copied(), &inputs).map_err(|m| self.error(key, ErrorKind::BadParameter, m))?;
+        let c = e
+            .compile(&|n| self.constants.get(n).copied(), &inputs)
+            .map_err(|m| self.error(key, ErrorKind::BadParameter, m))?;
         Ok((c, inputs))
     }
 
@@ -238,7 +277,13 @@ impl ElementSpec<'_> {
                 toml::Value::Array(items) => items
                     .iter()
                     .map(|v| {
-                        let e = self.expr(key, &RawValue { value: v.clone(), span: raw.span.clone() })?;
+                        let e = self.expr(
+                            key,
+                            &RawValue {
+                                value: v.clone(),
+                                span: raw.span.clone(),
+                            },
+                        )?;
                         self.constant_of(key, &e)
                     })
                     .collect(),
@@ -248,20 +293,42 @@ impl ElementSpec<'_> {
     }
 
     /// A matrix of expressions (array of equal-length arrays), compiled with shared inputs.
-    pub fn matrix(&self, key: &str, what: &str) -> Result<(usize, usize, Vec<String>, Vec<Compiled>), ModelError> {
+    pub fn matrix(
+        &self,
+        key: &str,
+        what: &str,
+    ) -> Result<(usize, usize, Vec<String>, Vec<Compiled>), ModelError> {
         let raw = self.ask(key).ok_or_else(|| self.missing(key, what))?;
-        let shape_err = || self.error(key, ErrorKind::BadParameter, format!("`{key}` must be an array of rows of equal length, e.g. [[1, 0], [0, \"x.q\"]]"));
-        let toml::Value::Array(rows) = &raw.value else { return Err(shape_err()) };
+        let shape_err = || {
+            self.error(
+                key,
+                ErrorKind::BadParameter,
+                format!(
+                    "`{key}` must be an array of rows of equal length, e.g. [[1, 0], [0, \"x.q\"]]"
+                ),
+            )
+        };
+        let toml::Value::Array(rows) = &raw.value else {
+            return Err(shape_err());
+        };
         let mut exprs = Vec::new();
         let mut cols = None;
         for row in rows {
-            let toml::Value::Array(r) = row else { return Err(shape_err()) };
+            let toml::Value::Array(r) = row else {
+                return Err(shape_err());
+            };
             if cols.is_some_and(|c| c != r.len()) || r.is_empty() {
                 return Err(shape_err());
             }
             cols = Some(r.len());
             for v in r {
-                exprs.push(self.expr(key, &RawValue { value: v.clone(), span: raw.span.clone() })?);
+                exprs.push(self.expr(
+                    key,
+                    &RawValue {
+                        value: v.clone(),
+                        span: raw.span.clone(),
+                    },
+                )?);
             }
         }
         let (n1, n2) = (rows.len(), cols.unwrap_or(0));
@@ -284,7 +351,8 @@ impl ElementSpec<'_> {
                         self.used_constants.borrow_mut().insert(n);
                     }
                 }
-                e.compile(&|n| self.constants.get(n).copied(), &inputs).map_err(|m| self.error(key, ErrorKind::BadParameter, m))
+                e.compile(&|n| self.constants.get(n).copied(), &inputs)
+                    .map_err(|m| self.error(key, ErrorKind::BadParameter, m))
             })
             .collect::<Result<Vec<_>, _>>()?;
         Ok((n1, n2, inputs, compiled))
@@ -295,7 +363,11 @@ impl ElementSpec<'_> {
         let raw = self.ask(key).ok_or_else(|| self.missing(key, what))?;
         match &raw.value {
             toml::Value::String(s) if !s.trim().is_empty() => Ok(s.trim().to_owned()),
-            _ => Err(self.error(key, ErrorKind::BadParameter, format!("`{key}` must name a signal, e.g. \"spring.q\""))),
+            _ => Err(self.error(
+                key,
+                ErrorKind::BadParameter,
+                format!("`{key}` must name a signal, e.g. \"spring.q\""),
+            )),
         }
     }
 
@@ -303,15 +375,27 @@ impl ElementSpec<'_> {
     pub fn string_or(&self, key: &str, default: &str) -> Result<String, ModelError> {
         match self.ask(key) {
             None => Ok(default.to_owned()),
-            Some(RawValue { value: toml::Value::String(s), .. }) => Ok(s.clone()),
-            Some(_) => Err(self.error(key, ErrorKind::BadParameter, format!("`{key}` must be a string"))),
+            Some(RawValue {
+                value: toml::Value::String(s),
+                ..
+            }) => Ok(s.clone()),
+            Some(_) => Err(self.error(
+                key,
+                ErrorKind::BadParameter,
+                format!("`{key}` must be a string"),
+            )),
         }
     }
 
     /// Keys given but never read, and the keys that were read.
     pub(crate) fn unused(&self) -> (Vec<String>, Vec<String>) {
         let asked = self.asked.borrow().clone();
-        let unused = self.params.keys().filter(|k| !asked.contains(k)).cloned().collect();
+        let unused = self
+            .params
+            .keys()
+            .filter(|k| !asked.contains(k))
+            .cloned()
+            .collect();
         (unused, asked)
     }
 }

@@ -6,7 +6,9 @@
 //! component-wise with one displacement per component.
 
 use crate::bond::PortCausality;
-use crate::element::{CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Stage, StateSpec};
+use crate::element::{
+    CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Stage, StateSpec,
+};
 use crate::elements::component_names;
 use crate::error::ParamError;
 
@@ -29,7 +31,10 @@ impl Capacitor {
             ParamError::positive("c", v)?;
         }
         if q0.is_empty() {
-            return Err(ParamError::Shape { param: "q0".into(), message: "needs at least one component".into() });
+            return Err(ParamError::Shape {
+                param: "q0".into(),
+                message: "needs at least one component".into(),
+            });
         }
         for &q in &q0 {
             ParamError::finite("q0", q)?;

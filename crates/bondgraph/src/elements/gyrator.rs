@@ -46,12 +46,20 @@ impl Element for Gyrator {
         let n = self.r.n_inputs();
         let stage = |write: Slot, read: Slot| Stage {
             writes: vec![write],
-            reads: std::iter::once(read).chain((0..n).map(Slot::Input)).collect(),
+            reads: std::iter::once(read)
+                .chain((0..n).map(Slot::Input))
+                .collect(),
         };
         if causality[0] == PortCausality::EffortOut {
-            vec![stage(Slot::Effort(0), Slot::Flow(1)), stage(Slot::Effort(1), Slot::Flow(0))]
+            vec![
+                stage(Slot::Effort(0), Slot::Flow(1)),
+                stage(Slot::Effort(1), Slot::Flow(0)),
+            ]
         } else {
-            vec![stage(Slot::Flow(1), Slot::Effort(0)), stage(Slot::Flow(0), Slot::Effort(1))]
+            vec![
+                stage(Slot::Flow(1), Slot::Effort(0)),
+                stage(Slot::Flow(0), Slot::Effort(1)),
+            ]
         }
     }
     fn eval(&self, stage: usize, io: &mut Io<'_>) {

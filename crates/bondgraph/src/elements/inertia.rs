@@ -5,7 +5,9 @@
 //! `I` on a 2-bond).
 
 use crate::bond::PortCausality;
-use crate::element::{CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Stage, StateSpec};
+use crate::element::{
+    CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Stage, StateSpec,
+};
 use crate::elements::component_names;
 use crate::error::ParamError;
 
@@ -28,7 +30,10 @@ impl Inertia {
             ParamError::positive("m", v)?;
         }
         if p0.is_empty() {
-            return Err(ParamError::Shape { param: "p0".into(), message: "needs at least one component".into() });
+            return Err(ParamError::Shape {
+                param: "p0".into(),
+                message: "needs at least one component".into(),
+            });
         }
         for &p in &p0 {
             ParamError::finite("p0", p)?;

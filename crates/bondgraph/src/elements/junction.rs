@@ -10,15 +10,28 @@ use crate::bond::PortCausality;
 use crate::element::{CausalRule, Element, Io, Ports, Slot, Stage};
 
 fn dominant(io: &Io<'_>, c: PortCausality) -> usize {
-    (0..io.n_ports()).find(|&p| io.causality(p) == c).unwrap_or(0)
+    (0..io.n_ports())
+        .find(|&p| io.causality(p) == c)
+        .unwrap_or(0)
 }
 
-fn two_stages(causality: &[PortCausality], dominant_c: PortCausality, common: fn(usize) -> Slot, summed: fn(usize) -> Slot) -> Vec<Stage> {
+fn two_stages(
+    causality: &[PortCausality],
+    dominant_c: PortCausality,
+    common: fn(usize) -> Slot,
+    summed: fn(usize) -> Slot,
+) -> Vec<Stage> {
     let d = causality.iter().position(|&c| c == dominant_c).unwrap_or(0);
     let others: Vec<usize> = (0..causality.len()).filter(|&p| p != d).collect();
     vec![
-        Stage { writes: others.iter().map(|&p| common(p)).collect(), reads: vec![common(d)] },
-        Stage { writes: vec![summed(d)], reads: others.iter().map(|&p| summed(p)).collect() },
+        Stage {
+            writes: others.iter().map(|&p| common(p)).collect(),
+            reads: vec![common(d)],
+        },
+        Stage {
+            writes: vec![summed(d)],
+            reads: others.iter().map(|&p| summed(p)).collect(),
+        },
     ]
 }
 
@@ -48,7 +61,10 @@ impl Element for ZeroJunction {
                     io.set_e(p, k, e);
                 }
             } else {
-                let sum: f64 = (0..io.n_ports()).filter(|&p| p != d).map(|p| io.f_in(p, k)).sum();
+                let sum: f64 = (0..io.n_ports())
+                    .filter(|&p| p != d)
+                    .map(|p| io.f_in(p, k))
+                    .sum();
                 io.set_f_in(d, k, -sum);
             }
         }
@@ -70,7 +86,12 @@ impl Element for OneJunction {
         CausalRule::ExactlyOne(PortCausality::EffortOut)
     }
     fn stages(&self, causality: &[PortCausality]) -> Vec<Stage> {
-        two_stages(causality, PortCausality::EffortOut, Slot::Flow, Slot::Effort)
+        two_stages(
+            causality,
+            PortCausality::EffortOut,
+            Slot::Flow,
+            Slot::Effort,
+        )
     }
     fn eval(&self, stage: usize, io: &mut Io<'_>) {
         let d = dominant(io, PortCausality::EffortOut);
@@ -83,7 +104,10 @@ impl Element for OneJunction {
                     io.set_f_in(p, k, s * f);
                 }
             } else {
-                let sum: f64 = (0..io.n_ports()).filter(|&p| p != d).map(|p| io.sign(p) * io.e(p, k)).sum();
+                let sum: f64 = (0..io.n_ports())
+                    .filter(|&p| p != d)
+                    .map(|p| io.sign(p) * io.e(p, k))
+                    .sum();
                 let s = io.sign(d);
                 io.set_e(d, k, -s * sum);
             }

@@ -20,7 +20,11 @@ impl Lag {
     pub fn new(input: &str, tau: f64, y0: f64) -> Result<Self, ParamError> {
         ParamError::positive("tau", tau)?;
         ParamError::finite("y0", y0)?;
-        Ok(Self { input: input.to_owned(), tau, y0 })
+        Ok(Self {
+            input: input.to_owned(),
+            tau,
+            y0,
+        })
     }
 }
 

@@ -30,17 +30,34 @@ pub struct MatrixTransformer {
 
 impl MatrixTransformer {
     /// An MTF with an n₁×n₂ modulus computed by `law` from the signals `inputs`.
-    pub fn new(n1: usize, n2: usize, inputs: Vec<SignalSpec>, law: ModulusLaw) -> Result<Self, ParamError> {
+    pub fn new(
+        n1: usize,
+        n2: usize,
+        inputs: Vec<SignalSpec>,
+        law: ModulusLaw,
+    ) -> Result<Self, ParamError> {
         if n1 == 0 || n2 == 0 {
-            return Err(ParamError::Shape { param: "T".into(), message: format!("modulus must be at least 1×1, got {n1}×{n2}") });
+            return Err(ParamError::Shape {
+                param: "T".into(),
+                message: format!("modulus must be at least 1×1, got {n1}×{n2}"),
+            });
         }
-        Ok(Self { n1, n2, inputs, law, scratch: RefCell::new(DMatrix::zeros(n1, n2)) })
+        Ok(Self {
+            n1,
+            n2,
+            inputs,
+            law,
+            scratch: RefCell::new(DMatrix::zeros(n1, n2)),
+        })
     }
 
     /// A constant matrix modulus.
     pub fn constant(t: DMatrix<f64>) -> Result<Self, ParamError> {
         if t.iter().any(|v| !v.is_finite()) {
-            return Err(ParamError::Shape { param: "T".into(), message: "entries must be finite".into() });
+            return Err(ParamError::Shape {
+                param: "T".into(),
+                message: "entries must be finite".into(),
+            });
         }
         let (n1, n2) = t.shape();
         Self::new(n1, n2, Vec::new(), Box::new(move |_, m| m.copy_from(&t)))
@@ -49,7 +66,11 @@ impl MatrixTransformer {
 
 impl fmt::Debug for MatrixTransformer {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "MatrixTransformer({}×{}, inputs {:?})", self.n1, self.n2, self.inputs)
+        write!(
+            f,
+            "MatrixTransformer({}×{}, inputs {:?})",
+            self.n1, self.n2, self.inputs
+        )
     }
 }
 
@@ -58,7 +79,10 @@ impl Element for MatrixTransformer {
         "MTF"
     }
     fn ports(&self) -> Ports {
-        Ports::Fixed(vec![PortSpec::new("1", self.n1), PortSpec::new("2", self.n2)])
+        Ports::Fixed(vec![
+            PortSpec::new("1", self.n1),
+            PortSpec::new("2", self.n2),
+        ])
     }
     fn causal_rule(&self, _: usize) -> CausalRule {
         CausalRule::Fixed(vec![PortCausality::EffortOut, PortCausality::FlowOut])
@@ -68,10 +92,20 @@ impl Element for MatrixTransformer {
     }
     fn stages(&self, _: &[PortCausality]) -> Vec<Stage> {
         let modulation: Vec<Slot> = (0..self.inputs.len()).map(Slot::Input).collect();
-        let with = |s: Slot| std::iter::once(s).chain(modulation.iter().copied()).collect();
+        let with = |s: Slot| {
+            std::iter::once(s)
+                .chain(modulation.iter().copied())
+                .collect()
+        };
         vec![
-            Stage { writes: vec![Slot::Effort(0)], reads: with(Slot::Effort(1)) },
-            Stage { writes: vec![Slot::Flow(1)], reads: with(Slot::Flow(0)) },
+            Stage {
+                writes: vec![Slot::Effort(0)],
+                reads: with(Slot::Effort(1)),
+            },
+            Stage {
+                writes: vec![Slot::Flow(1)],
+                reads: with(Slot::Flow(0)),
+            },
         ]
     }
     fn eval(&self, stage: usize, io: &mut Io<'_>) {

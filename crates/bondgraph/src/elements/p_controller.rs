@@ -18,16 +18,31 @@ pub struct PController {
 
 impl PController {
     /// A controller reading `measured`; `lo < hi` (infinite limits allowed), finite gain.
-    pub fn new(measured: &str, gain: f64, setpoint: impl Into<Param>, lo: f64, hi: f64) -> Result<Self, ParamError> {
+    pub fn new(
+        measured: &str,
+        gain: f64,
+        setpoint: impl Into<Param>,
+        lo: f64,
+        hi: f64,
+    ) -> Result<Self, ParamError> {
         ParamError::finite("gain", gain)?;
         let setpoint = setpoint.into();
         if let Some(r) = setpoint.constant() {
             ParamError::finite("setpoint", r)?;
         }
         if lo.is_nan() || hi.is_nan() || lo >= hi {
-            return Err(ParamError::Shape { param: "limits".into(), message: format!("need min < max, got [{lo}, {hi}]") });
+            return Err(ParamError::Shape {
+                param: "limits".into(),
+                message: format!("need min < max, got [{lo}, {hi}]"),
+            });
         }
-        Ok(Self { measured: measured.to_owned(), gain, setpoint, lo, hi })
+        Ok(Self {
+            measured: measured.to_owned(),
+            gain,
+            setpoint,
+            lo,
+            hi,
+        })
     }
 }
 

@@ -68,6 +68,9 @@ mod tests {
     #[test]
     fn zero_resistance_offers_only_resistance_causality() {
         let r = Resistor::new(0.0).unwrap();
-        assert_eq!(r.causal_rule(1), CausalRule::Resistive(vec![vec![PortCausality::EffortOut]]));
+        assert_eq!(
+            r.causal_rule(1),
+            CausalRule::Resistive(vec![vec![PortCausality::EffortOut]])
+        );
     }
 }

@@ -16,7 +16,9 @@ pub struct EffortSource {
 impl EffortSource {
     /// A source of the given effort.
     pub fn new(value: impl Into<Param>) -> Self {
-        Self { value: value.into() }
+        Self {
+            value: value.into(),
+        }
     }
 }
 
@@ -55,7 +57,9 @@ pub struct FlowSource {
 impl FlowSource {
     /// A source delivering the given flow along its outgoing bond.
     pub fn new(value: impl Into<Param>) -> Self {
-        Self { value: value.into() }
+        Self {
+            value: value.into(),
+        }
     }
 }
 

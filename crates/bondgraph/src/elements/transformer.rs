@@ -44,15 +44,25 @@ impl Element for Transformer {
     }
     fn stages(&self, causality: &[PortCausality]) -> Vec<Stage> {
         // Effort travels from the FlowOut side to the EffortOut side, flow the other way.
-        let (out, inp) = if causality[0] == PortCausality::EffortOut { (0, 1) } else { (1, 0) };
+        let (out, inp) = if causality[0] == PortCausality::EffortOut {
+            (0, 1)
+        } else {
+            (1, 0)
+        };
         let mut modulation: Vec<Slot> = (0..self.m.n_inputs()).map(Slot::Input).collect();
         let mut effort = vec![Slot::Effort(inp)];
         effort.append(&mut modulation.clone());
         let mut flow = vec![Slot::Flow(out)];
         flow.append(&mut modulation);
         vec![
-            Stage { writes: vec![Slot::Effort(out)], reads: effort },
-            Stage { writes: vec![Slot::Flow(inp)], reads: flow },
+            Stage {
+                writes: vec![Slot::Effort(out)],
+                reads: effort,
+            },
+            Stage {
+                writes: vec![Slot::Flow(inp)],
+                reads: flow,
+            },
         ]
     }
     fn eval(&self, stage: usize, io: &mut Io<'_>) {
@@ -78,6 +88,11 @@ mod tests {
         assert!(Transformer::new(0.0).is_err());
         assert!(Transformer::new(f64::NAN).is_err());
         assert_eq!(Transformer::new(2.0).unwrap().kind(), "TF");
-        assert_eq!(Transformer::new(Param::modulated(vec!["t".into()], |t, _| t)).unwrap().kind(), "MTF");
+        assert_eq!(
+            Transformer::new(Param::modulated(vec!["t".into()], |t, _| t))
+                .unwrap()
+                .kind(),
+            "MTF"
+        );
     }
 }

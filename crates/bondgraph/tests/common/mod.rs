@@ -16,18 +16,25 @@ pub fn assemble(g: BondGraph) -> StateEquations {
 /// Connect a list of `from -> to` name pairs.
 pub fn bond_all(g: &mut BondGraph, pairs: &[(&str, &str)]) {
     for (from, to) in pairs {
-        g.connect_names(from, to).unwrap_or_else(|e| panic!("{from} -> {to}: {e}"));
+        g.connect_names(from, to)
+            .unwrap_or_else(|e| panic!("{from} -> {to}: {e}"));
     }
 }
 
 /// An output column reading `probe`.
 pub fn output(eqs: &StateEquations, name: &str) -> Output {
-    Output { name: name.to_owned(), probe: eqs.probe(name).unwrap_or_else(|| panic!("no probe `{name}`")) }
+    Output {
+        name: name.to_owned(),
+        probe: eqs
+            .probe(name)
+            .unwrap_or_else(|| panic!("no probe `{name}`")),
+    }
 }
 
 /// Index of a named column of a trajectory.
 pub fn col(traj: &Trajectory, name: &str) -> Vec<f64> {
-    traj.column(name).unwrap_or_else(|| panic!("no column `{name}` in {:?}", traj.columns))
+    traj.column(name)
+        .unwrap_or_else(|| panic!("no column `{name}` in {:?}", traj.columns))
 }
 
 /// Free response of x'' + 2αx' + ω0²x = 0 from (x0, v0), for α < ω0 (underdamped or
@@ -53,7 +60,8 @@ pub fn mass_spring_damper(m: f64, k: f64, r: f64, q0: f64) -> StateEquations {
     let mut g = BondGraph::new();
     g.add("v", OneJunction).unwrap();
     g.add("mass", Inertia::new(m, 0.0).unwrap()).unwrap();
-    g.add("spring", Capacitor::new(1.0 / k, q0).unwrap()).unwrap();
+    g.add("spring", Capacitor::new(1.0 / k, q0).unwrap())
+        .unwrap();
     g.add("damper", Resistor::new(r).unwrap()).unwrap();
     bond_all(&mut g, &[("v", "mass"), ("v", "spring"), ("v", "damper")]);
     assemble(g)
@@ -68,7 +76,10 @@ pub fn series_rlc(v: f64, r: f64, l: f64, c: f64) -> StateEquations {
     g.add("L", Inertia::new(l, 0.0).unwrap()).unwrap();
     g.add("R", Resistor::new(r).unwrap()).unwrap();
     g.add("C", Capacitor::new(c, 0.0).unwrap()).unwrap();
-    bond_all(&mut g, &[("src", "loop"), ("loop", "L"), ("loop", "R"), ("loop", "C")]);
+    bond_all(
+        &mut g,
+        &[("src", "loop"), ("loop", "L"), ("loop", "R"), ("loop", "C")],
+    );
     assemble(g)
 }
 
@@ -77,13 +88,22 @@ pub fn series_rlc(v: f64, r: f64, l: f64, c: f64) -> StateEquations {
 /// `j2`. An optional `damper` on `j1`. Initial spring deflection `q0`, masses at rest.
 ///
 /// Port numbers are given explicitly with `connect((id, Some(port)), …)`.
-pub fn lever(tf: Transformer, m1: f64, m2: f64, k: f64, q0: f64, damping: Option<f64>) -> StateEquations {
+pub fn lever(
+    tf: Transformer,
+    m1: f64,
+    m2: f64,
+    k: f64,
+    q0: f64,
+    damping: Option<f64>,
+) -> StateEquations {
     let mut g = BondGraph::new();
     let j1 = g.add("j1", OneJunction).unwrap();
     let i1 = g.add("m1", Inertia::new(m1, 0.0).unwrap()).unwrap();
     let t = g.add("tf", tf).unwrap();
     let z = g.add("z", ZeroJunction).unwrap();
-    let c = g.add("spring", Capacitor::new(1.0 / k, q0).unwrap()).unwrap();
+    let c = g
+        .add("spring", Capacitor::new(1.0 / k, q0).unwrap())
+        .unwrap();
     let j2 = g.add("j2", OneJunction).unwrap();
     let i2 = g.add("m2", Inertia::new(m2, 0.0).unwrap()).unwrap();
     g.connect((j1, None), (i1, Some(0))).unwrap();
@@ -101,7 +121,14 @@ pub fn lever(tf: Transformer, m1: f64, m2: f64, k: f64, q0: f64, damping: Option
 
 /// DC motor: `V` (Se) → `elec` (1-junction) with `Ra` (R) [and `La` (I)] → `gy` (GY, k) →
 /// `mech` (1-junction) with `J` (I) and `b` (R, friction). Rotor speed = `J.f`.
-pub fn dc_motor(v: f64, ra: f64, la: Option<f64>, k: impl Into<Param>, j: f64, b: f64) -> StateEquations {
+pub fn dc_motor(
+    v: f64,
+    ra: f64,
+    la: Option<f64>,
+    k: impl Into<Param>,
+    j: f64,
+    b: f64,
+) -> StateEquations {
     let mut g = BondGraph::new();
     g.add("V", EffortSource::new(v)).unwrap();
     g.add("elec", OneJunction).unwrap();
@@ -110,7 +137,17 @@ pub fn dc_motor(v: f64, ra: f64, la: Option<f64>, k: impl Into<Param>, j: f64, b
     g.add("mech", OneJunction).unwrap();
     g.add("J", Inertia::new(j, 0.0).unwrap()).unwrap();
     g.add("b", Resistor::new(b).unwrap()).unwrap();
-    bond_all(&mut g, &[("V", "elec"), ("elec", "Ra"), ("elec", "gy"), ("gy", "mech"), ("mech", "J"), ("mech", "b")]);
+    bond_all(
+        &mut g,
+        &[
+            ("V", "elec"),
+            ("elec", "Ra"),
+            ("elec", "gy"),
+            ("gy", "mech"),
+            ("mech", "J"),
+            ("mech", "b"),
+        ],
+    );
     if let Some(l) = la {
         g.add("La", Inertia::new(l, 0.0).unwrap()).unwrap();
         bond_all(&mut g, &[("elec", "La")]);
@@ -120,7 +157,8 @@ pub fn dc_motor(v: f64, ra: f64, la: Option<f64>, k: impl Into<Param>, j: f64, b
 
 /// The lever with a modulated ratio m = 1 + spring.q (an MTF reading a displacement).
 pub fn modulated_lever(damping: Option<f64>) -> StateEquations {
-    let tf = Transformer::new(Param::modulated(vec!["spring.q".into()], |_, u| 1.0 + u[0])).unwrap();
+    let tf =
+        Transformer::new(Param::modulated(vec!["spring.q".into()], |_, u| 1.0 + u[0])).unwrap();
     lever(tf, 1.5, 0.5, 40.0, 0.05, damping)
 }
 
@@ -130,7 +168,9 @@ pub fn modulated_lever(damping: Option<f64>) -> StateEquations {
 pub fn planar_matrix_mtf() -> StateEquations {
     let mut g = BondGraph::new();
     let jm = g.add("jm", OneJunction).unwrap();
-    let mass = g.add("mass", Inertia::multi(2.0, vec![0.3, -0.2]).unwrap()).unwrap();
+    let mass = g
+        .add("mass", Inertia::multi(2.0, vec![0.3, -0.2]).unwrap())
+        .unwrap();
     // nalgebra is not a dev-dependency: the matrix type is inferred from `MatrixTransformer::new`.
     let mtf = MatrixTransformer::new(
         2,
@@ -145,7 +185,9 @@ pub fn planar_matrix_mtf() -> StateEquations {
     .unwrap();
     let mtf = g.add("mtf", mtf).unwrap();
     let z = g.add("z", ZeroJunction).unwrap();
-    let c = g.add("spring", Capacitor::new(0.05, 0.01).unwrap()).unwrap();
+    let c = g
+        .add("spring", Capacitor::new(0.05, 0.01).unwrap())
+        .unwrap();
     let d = g.add("damper", Resistor::new(0.7).unwrap()).unwrap();
     g.connect((jm, None), (mass, Some(0))).unwrap();
     g.connect((jm, None), (mtf, Some(0))).unwrap();
@@ -161,11 +203,22 @@ pub fn boxed_law<T>(f: impl Fn(&Io<'_>, &mut T) + 'static) -> Box<dyn Fn(&Io<'_>
 }
 
 /// `t[ij] = v` for a matrix whose type is not named here.
-pub fn set<T: std::ops::IndexMut<(usize, usize), Output = f64>>(t: &mut T, ij: (usize, usize), v: f64) {
+pub fn set<T: std::ops::IndexMut<(usize, usize), Output = f64>>(
+    t: &mut T,
+    ij: (usize, usize),
+    v: f64,
+) {
     t[ij] = v;
 }
 
 /// Settings for a run of `t_end` seconds.
 pub fn settings(method: Method, t_end: f64, dt_out: f64, rtol: f64, atol: f64) -> Settings {
-    Settings { t_start: 0.0, t_end, dt_out, method, rtol, atol }
+    Settings {
+        t_start: 0.0,
+        t_end,
+        dt_out,
+        method,
+        rtol,
+        atol,
+    }
 }

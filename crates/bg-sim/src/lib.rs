@@ -1,0 +1,10 @@
+//! The `bg-sim` front end as a library: the registry of every element kind this build
+//! knows, shared by the CLI and the workspace tests. No physics lives here.
+
+use bg_model::Registry;
+
+/// Every element kind this build knows: the core kinds plus the domain crates'.
+#[must_use]
+pub fn registry() -> Registry {
+    Registry::with_core()
+}
