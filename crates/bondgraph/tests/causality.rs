@@ -265,6 +265,48 @@ fn flow_source_beside_resistor_is_not_an_algebraic_loop() {
     assert_abs_diff_eq!(i_end, f * (1.0 - (-r * 0.5 / l).exp()), epsilon = 1e-7 * f);
 }
 
+/// A junction structure with a cycle that sources and storages leave undecided, so SCAP's
+/// last step orients bonds arbitrarily: three 0-junctions Z1..Z3 (each with an inertia) and
+/// three 1-junctions J1..J3 (each with a compliance), every Zi bonded to every Jj (K₃,₃).
+/// Integral causality exists: each Zi takes its effort from one Jσ(i) for a permutation σ.
+/// The arbitrary choices must respect the rules of both ends; the equations then hold a real
+/// algebraic loop (each Z's effort is a sum over the other Z's efforts), which
+/// `StateEquations::new` reports.
+#[test]
+fn arbitrary_orientation_of_a_junction_cycle_respects_both_ends() {
+    let mut g = BondGraph::new();
+    for i in 1..=3 {
+        g.add(&format!("Z{i}"), ZeroJunction).unwrap();
+        g.add(&format!("J{i}"), OneJunction).unwrap();
+        g.add(&format!("I{i}"), Inertia::new(1.0, 0.0).unwrap()).unwrap();
+        g.add(&format!("C{i}"), Capacitor::new(1.0, 0.0).unwrap()).unwrap();
+    }
+    for i in 1..=3 {
+        bond_all(&mut g, &[(&format!("Z{i}"), &format!("I{i}")), (&format!("J{i}"), &format!("C{i}"))]);
+    }
+    for i in 1..=3 {
+        for j in 1..=3 {
+            bond_all(&mut g, &[(&format!("Z{i}"), &format!("J{j}"))]);
+        }
+    }
+    let causal = assign_causality(g).unwrap_or_else(|e| panic!("a valid integral causality exists, but: {e}"));
+    for i in 1..=3 {
+        for (name, dominant) in [(format!("Z{i}"), PortCausality::FlowOut), (format!("J{i}"), PortCausality::EffortOut)] {
+            let c = causal.element_causality(causal.graph.find(&name).unwrap());
+            assert_eq!(c.iter().filter(|&&x| x == dominant).count(), 1, "{name}: {c:?}");
+        }
+        assert_eq!(causal.element_causality(causal.graph.find(&format!("I{i}")).unwrap()), vec![PortCausality::FlowOut]);
+        assert_eq!(causal.element_causality(causal.graph.find(&format!("C{i}")).unwrap()), vec![PortCausality::EffortOut]);
+    }
+    match StateEquations::new(causal).unwrap_err() {
+        Error::Causality(CausalityError::AlgebraicLoop { elements, .. }) => {
+            assert!(elements.iter().all(|e| e.starts_with('Z') || e.starts_with('J')), "{elements:?}");
+            assert_eq!(elements.len(), 6, "{elements:?}");
+        }
+        other => panic!("expected an algebraic loop, got {other:?}"),
+    }
+}
+
 /// SCAP on the mass–spring–damper: mass flow out, spring effort out, damper in resistance
 /// causality; the 1-junction's dominant bond is the mass's.
 #[test]

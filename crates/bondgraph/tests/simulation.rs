@@ -187,6 +187,34 @@ fn event_with_wrong_replacement_stops_the_run() {
     assert_eq!(eqs.graph().node(damper).element.kind(), "R");
 }
 
+/// An event is applied whole or not at all: when one of its replacements is refused, the
+/// others are not applied either and the event is not counted ("scheduled events applied").
+#[test]
+fn refused_event_is_neither_applied_nor_counted() {
+    let (r0, r_new) = (0.4, 3.0);
+    let mut eqs = mass_spring_damper(1.0, 100.0, r0, 0.01);
+    let damper = eqs.graph().find("damper").unwrap();
+    let spring = eqs.graph().find("spring").unwrap();
+    let x0 = eqs.initial_state();
+    let outs = [output(&eqs, "spring.q")];
+    let event = Event {
+        t: 0.3,
+        replacements: vec![
+            (damper, Box::new(Resistor::new(r_new).unwrap())),   // acceptable on its own
+            (spring, Box::new(Inertia::new(1.0, 0.0).unwrap())), // refused: a different kind
+        ],
+    };
+    let run = simulate(&mut eqs, &x0, &settings(Method::Bdf, 1.0, 0.1, 1e-8, 1e-12), &outs, vec![event]);
+    assert!(matches!(&run.error, Some(SimulationError::Event { source: GraphError::Replacement { element, .. }, .. }) if element == "spring"), "{:?}", run.error);
+    assert_eq!(run.stats.events, 0, "a refused event was counted as applied");
+    // The damper still has r0: its force at unit velocity is r0.
+    let x = vec![1.0, 0.0]; // mass.p = 1 (v = 1), spring.q = 0
+    assert_eq!(eqs.states()[0].name, "mass.p");
+    eqs.evaluate(0.0, &x);
+    let e = eqs.read(eqs.probe("damper.e").unwrap(), 0.0, &x);
+    assert_abs_diff_eq!(e, r0, epsilon = 1e-15);
+}
+
 /// A resistor in conductance causality (f = e/r: C discharging through R on a 0-junction)
 /// must not be switched to r = 0 by an event: its causality no longer fits. The switch must be
 /// refused when the event is applied (`SimulationError::Event` naming the resistor), keeping

@@ -3,7 +3,8 @@
 //! Causality: integral (effort out); derivative causality is refused. The compliance `c`
 //! may be modulated (a chamber whose volume follows a stroke); then the stored energy is
 //! not conserved, since the modulation does work. On a multibond the law applies
-//! component-wise with one displacement per component.
+//! component-wise with one displacement per component. The displacement's nominal magnitude
+//! (its absolute-tolerance scale) is `c`: the displacement at one unit of effort.
 
 use crate::bond::PortCausality;
 use crate::element::{
@@ -57,7 +58,7 @@ impl Element for Capacitor {
         component_names("q", self.q0.len())
             .iter()
             .zip(&self.q0)
-            .map(|(n, &q)| StateSpec::new(n, q))
+            .map(|(n, &q)| StateSpec::new(n, q).nominal(self.c.constant().unwrap_or(1.0)))
             .collect()
     }
     fn signal_inputs(&self) -> Vec<SignalSpec> {

@@ -2,7 +2,8 @@
 //!
 //! Causality: integral (flow out); derivative causality is refused. On a multibond the law
 //! applies component-wise with one momentum per component (a point mass in the plane is an
-//! `I` on a 2-bond).
+//! `I` on a 2-bond). The momentum's nominal magnitude (its absolute-tolerance scale) is `m`:
+//! the momentum at one unit of flow.
 
 use crate::bond::PortCausality;
 use crate::element::{
@@ -56,7 +57,7 @@ impl Element for Inertia {
         component_names("p", self.p0.len())
             .iter()
             .zip(&self.p0)
-            .map(|(n, &p)| StateSpec::new(n, p))
+            .map(|(n, &p)| StateSpec::new(n, p).nominal(self.m.constant().unwrap_or(1.0)))
             .collect()
     }
     fn signal_inputs(&self) -> Vec<SignalSpec> {

@@ -1,0 +1,41 @@
+//! Every ```toml block of the documentation is a complete model that loads, runs and passes
+//! its checks, so the docs cannot drift from the format.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use bg_tests::root;
+
+fn toml_blocks(text: &str) -> Vec<String> {
+    let mut blocks = Vec::new();
+    let mut current: Option<String> = None;
+    for line in text.lines() {
+        match (&mut current, line.trim_start()) {
+            (None, l) if l == "```toml" => current = Some(String::new()),
+            (Some(_), "```") => blocks.extend(current.take()),
+            (Some(b), _) => {
+                b.push_str(line);
+                b.push('\n');
+            }
+            _ => {}
+        }
+    }
+    blocks
+}
+
+#[test]
+fn model_format_examples_load_and_run() {
+    let mut n = 0;
+    for doc in ["docs/model-format.md", "README.md"] {
+        let text = std::fs::read_to_string(root().join(doc)).unwrap();
+        for (i, block) in toml_blocks(&text).into_iter().enumerate() {
+            let name = format!("{doc} block {}", i + 1);
+            let mut model = bg_model::Model::from_text(&name, &block, &bg_sim::registry(), &[]).unwrap_or_else(|e| panic!("{e}"));
+            let out = model.run().unwrap();
+            assert!(out.error.is_none(), "{name}: {:?}", out.error);
+            for c in model.verify(&out.trajectory) {
+                assert!(c.passed, "{name}: check {} failed: {:e}", c.value, c.max_error);
+            }
+            n += 1;
+        }
+    }
+    assert!(n >= 4, "found only {n} examples");
+}
