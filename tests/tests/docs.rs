@@ -28,11 +28,16 @@ fn model_format_examples_load_and_run() {
         let text = std::fs::read_to_string(root().join(doc)).unwrap();
         for (i, block) in toml_blocks(&text).into_iter().enumerate() {
             let name = format!("{doc} block {}", i + 1);
-            let mut model = bg_model::Model::from_text(&name, &block, &bg_sim::registry(), &[]).unwrap_or_else(|e| panic!("{e}"));
+            let mut model = bg_model::Model::from_text(&name, &block, &bg_sim::registry(), &[])
+                .unwrap_or_else(|e| panic!("{e}"));
             let out = model.run().unwrap();
             assert!(out.error.is_none(), "{name}: {:?}", out.error);
             for c in model.verify(&out.trajectory) {
-                assert!(c.passed, "{name}: check {} failed: {:e}", c.value, c.max_error);
+                assert!(
+                    c.passed,
+                    "{name}: check {} failed: {:e}",
+                    c.value, c.max_error
+                );
             }
             n += 1;
         }

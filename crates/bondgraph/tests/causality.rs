@@ -278,29 +278,56 @@ fn arbitrary_orientation_of_a_junction_cycle_respects_both_ends() {
     for i in 1..=3 {
         g.add(&format!("Z{i}"), ZeroJunction).unwrap();
         g.add(&format!("J{i}"), OneJunction).unwrap();
-        g.add(&format!("I{i}"), Inertia::new(1.0, 0.0).unwrap()).unwrap();
-        g.add(&format!("C{i}"), Capacitor::new(1.0, 0.0).unwrap()).unwrap();
+        g.add(&format!("I{i}"), Inertia::new(1.0, 0.0).unwrap())
+            .unwrap();
+        g.add(&format!("C{i}"), Capacitor::new(1.0, 0.0).unwrap())
+            .unwrap();
     }
     for i in 1..=3 {
-        bond_all(&mut g, &[(&format!("Z{i}"), &format!("I{i}")), (&format!("J{i}"), &format!("C{i}"))]);
+        bond_all(
+            &mut g,
+            &[
+                (&format!("Z{i}"), &format!("I{i}")),
+                (&format!("J{i}"), &format!("C{i}")),
+            ],
+        );
     }
     for i in 1..=3 {
         for j in 1..=3 {
             bond_all(&mut g, &[(&format!("Z{i}"), &format!("J{j}"))]);
         }
     }
-    let causal = assign_causality(g).unwrap_or_else(|e| panic!("a valid integral causality exists, but: {e}"));
+    let causal = assign_causality(g)
+        .unwrap_or_else(|e| panic!("a valid integral causality exists, but: {e}"));
     for i in 1..=3 {
-        for (name, dominant) in [(format!("Z{i}"), PortCausality::FlowOut), (format!("J{i}"), PortCausality::EffortOut)] {
+        for (name, dominant) in [
+            (format!("Z{i}"), PortCausality::FlowOut),
+            (format!("J{i}"), PortCausality::EffortOut),
+        ] {
             let c = causal.element_causality(causal.graph.find(&name).unwrap());
-            assert_eq!(c.iter().filter(|&&x| x == dominant).count(), 1, "{name}: {c:?}");
+            assert_eq!(
+                c.iter().filter(|&&x| x == dominant).count(),
+                1,
+                "{name}: {c:?}"
+            );
         }
-        assert_eq!(causal.element_causality(causal.graph.find(&format!("I{i}")).unwrap()), vec![PortCausality::FlowOut]);
-        assert_eq!(causal.element_causality(causal.graph.find(&format!("C{i}")).unwrap()), vec![PortCausality::EffortOut]);
+        assert_eq!(
+            causal.element_causality(causal.graph.find(&format!("I{i}")).unwrap()),
+            vec![PortCausality::FlowOut]
+        );
+        assert_eq!(
+            causal.element_causality(causal.graph.find(&format!("C{i}")).unwrap()),
+            vec![PortCausality::EffortOut]
+        );
     }
     match StateEquations::new(causal).unwrap_err() {
         Error::Causality(CausalityError::AlgebraicLoop { elements, .. }) => {
-            assert!(elements.iter().all(|e| e.starts_with('Z') || e.starts_with('J')), "{elements:?}");
+            assert!(
+                elements
+                    .iter()
+                    .all(|e| e.starts_with('Z') || e.starts_with('J')),
+                "{elements:?}"
+            );
             assert_eq!(elements.len(), 6, "{elements:?}");
         }
         other => panic!("expected an algebraic loop, got {other:?}"),

@@ -200,13 +200,26 @@ fn refused_event_is_neither_applied_nor_counted() {
     let event = Event {
         t: 0.3,
         replacements: vec![
-            (damper, Box::new(Resistor::new(r_new).unwrap())),   // acceptable on its own
+            (damper, Box::new(Resistor::new(r_new).unwrap())), // acceptable on its own
             (spring, Box::new(Inertia::new(1.0, 0.0).unwrap())), // refused: a different kind
         ],
     };
-    let run = simulate(&mut eqs, &x0, &settings(Method::Bdf, 1.0, 0.1, 1e-8, 1e-12), &outs, vec![event]);
-    assert!(matches!(&run.error, Some(SimulationError::Event { source: GraphError::Replacement { element, .. }, .. }) if element == "spring"), "{:?}", run.error);
-    assert_eq!(run.stats.events, 0, "a refused event was counted as applied");
+    let run = simulate(
+        &mut eqs,
+        &x0,
+        &settings(Method::Bdf, 1.0, 0.1, 1e-8, 1e-12),
+        &outs,
+        vec![event],
+    );
+    assert!(
+        matches!(&run.error, Some(SimulationError::Event { source: GraphError::Replacement { element, .. }, .. }) if element == "spring"),
+        "{:?}",
+        run.error
+    );
+    assert_eq!(
+        run.stats.events, 0,
+        "a refused event was counted as applied"
+    );
     // The damper still has r0: its force at unit velocity is r0.
     let x = vec![1.0, 0.0]; // mass.p = 1 (v = 1), spring.q = 0
     assert_eq!(eqs.states()[0].name, "mass.p");
