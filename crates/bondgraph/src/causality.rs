@@ -171,6 +171,8 @@ impl Scap<'_> {
             if self.decided[b].is_none() {
                 let from = self.g.bond(b).from.element;
                 self.decide(b, from, from, None)?;
+                // `from`'s own rule must see the choice too, not only the other end's.
+                self.queue.push_front((from, Some(b)));
                 self.propagate()?;
             }
         }

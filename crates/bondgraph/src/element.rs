@@ -113,6 +113,20 @@ pub enum CausalRule {
     None,
 }
 
+impl CausalRule {
+    /// Whether `causality` (one entry per port) satisfies this rule.
+    #[must_use]
+    pub fn admits(&self, causality: &[PortCausality]) -> bool {
+        match self {
+            Self::Fixed(p) | Self::Integral(p) => p.as_slice() == causality,
+            Self::Resistive(ps) => ps.iter().any(|p| p.as_slice() == causality),
+            Self::ExactlyOne(c) => causality.iter().filter(|x| *x == c).count() == 1,
+            Self::AllEqual => causality.windows(2).all(|w| w[0] == w[1]),
+            Self::None => causality.is_empty(),
+        }
+    }
+}
+
 /// A variable an element reads or writes: a port's effort or flow, a signal input or output.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Slot {
@@ -395,7 +409,7 @@ pub enum Param {
     },
 }
 
-/// Most signal inputs a modulated parameter may read.
+/// Signal inputs a modulated parameter reads without allocating (more are allowed, slower).
 pub const MAX_PARAM_INPUTS: usize = 16;
 
 impl Param {
@@ -438,8 +452,12 @@ impl Param {
         match self {
             Self::Const(v) => *v,
             Self::Modulated { inputs, law } => {
+                let n = inputs.len();
+                if n > MAX_PARAM_INPUTS {
+                    let v: Vec<f64> = (0..n).map(|k| io.u(first + k)).collect();
+                    return law(io.time(), &v);
+                }
                 let mut buf = [0.0; MAX_PARAM_INPUTS];
-                let n = inputs.len().min(MAX_PARAM_INPUTS);
                 for (k, b) in buf.iter_mut().take(n).enumerate() {
                     *b = io.u(first + k);
                 }

@@ -487,23 +487,45 @@ impl StateEquations {
             .collect()
     }
 
-    /// Replace element `id` by one of identical shape (used by scheduled events).
+    /// Replace element `id` by one of identical shape that accepts the assigned causality
+    /// (used by scheduled events).
     pub fn replace(
         &mut self,
         id: ElementId,
         element: Box<dyn Element>,
     ) -> Result<Box<dyn Element>, GraphError> {
+        self.check_replacement(id, element.as_ref())?;
         self.graph.replace(id, element)
     }
 
-    /// Check a replacement would be accepted, without doing it.
+    /// Check a replacement would be accepted, without doing it: same kind, ports, states and
+    /// signals, a causal rule that admits the causality already assigned, and the same
+    /// stages (so the evaluation plan stays valid).
     pub fn check_replacement(
         &self,
         id: ElementId,
         element: &dyn Element,
     ) -> Result<(), GraphError> {
         let n = self.graph.node(id);
-        check_same_shape(&n.name, n.element.as_ref(), element)
+        check_same_shape(&n.name, n.element.as_ref(), element)?;
+        let causality: Vec<PortCausality> =
+            self.layouts[id].ports.iter().map(|p| p.causality).collect();
+        let err = |message: String| {
+            Err(GraphError::Replacement {
+                element: n.name.clone(),
+                message,
+            })
+        };
+        if !element.causal_rule(causality.len()).admits(&causality) {
+            return err(format!(
+                "the new {} does not accept the causality assigned to it ({causality:?}); hint: a resistance switched to 0 cannot stay in conductance causality, use a small value instead",
+                element.kind()
+            ));
+        }
+        if element.stages(&causality) != n.element.stages(&causality) {
+            return err("the new element computes in different stages".into());
+        }
+        Ok(())
     }
 
     /// dx/dt = f(t, x).

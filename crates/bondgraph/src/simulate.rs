@@ -329,6 +329,15 @@ pub fn simulate(
     loop {
         // Apply every event due now.
         while let Some(ev) = events.next_if(|e| e.t <= t || same_time(e.t, t)) {
+            // All or nothing: check every replacement before applying any.
+            let refused = ev
+                .replacements
+                .iter()
+                .find_map(|(id, el)| eqs.check_replacement(*id, el.as_ref()).err());
+            if let Some(source) = refused {
+                out.error = Some(SimulationError::Event { t: ev.t, source });
+                break;
+            }
             for (id, el) in ev.replacements {
                 if let Err(source) = eqs.replace(id, el) {
                     out.error = Some(SimulationError::Event { t: ev.t, source });

@@ -54,6 +54,15 @@ fn model(name: &str) -> (StateEquations, &'static [&'static str]) {
         ),
         "modulated lever" => (modulated_lever(Some(0.2)), &["1", "0", "MTF"]),
         "planar mass, matrix MTF" => (planar_matrix_mtf(), &["1", "0", "MTF"]),
+        "planar mass, constant matrix MTF" => (
+            planar_constant_mtf(2.0, 50.0, [0.3, -0.2], 0.02),
+            &["1", "0", "MTF"],
+        ),
+        "lever, inverse orientation" => (reversed_lever(0.5, 2.0, 30.0, 0.03), &["1", "TF"]),
+        "gyrator, admittance causality" => (
+            gyrator_between_capacitors(2.0, 0.5, 0.125, 0.1),
+            &["0", "GY"],
+        ),
         _ => panic!("no model {name}"),
     }
 }
@@ -188,6 +197,21 @@ fn power_modulated_lever() {
 #[test]
 fn power_planar_matrix_mtf() {
     power_property("planar mass, matrix MTF");
+}
+
+#[test]
+fn power_planar_constant_matrix_mtf() {
+    power_property("planar mass, constant matrix MTF");
+}
+
+#[test]
+fn power_lever_inverse_orientation() {
+    power_property("lever, inverse orientation");
+}
+
+#[test]
+fn power_gyrator_admittance_causality() {
+    power_property("gyrator, admittance causality");
 }
 
 proptest! {

@@ -58,6 +58,11 @@ fn set_path(item: &mut Item, path: &[&str], i: usize, value: Value) -> Result<()
         if !exists && path[0] == "elements" && path.len() == 2 {
             return Err((format!("the model has no element `{seg}`"), None));
         }
+        let mut value = value;
+        if let Some(old) = table.get(seg).and_then(Item::as_value) {
+            // keep the comment and spacing around the old value
+            *value.decor_mut() = old.decor().clone();
+        }
         table.insert(seg, Item::Value(value));
         return Ok(());
     }

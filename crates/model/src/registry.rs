@@ -343,6 +343,17 @@ impl ElementSpec<'_> {
                 }
             }
         }
+        if inputs.len() > bondgraph::element::MAX_PARAM_INPUTS {
+            return Err(self.error(
+                key,
+                ErrorKind::BadParameter,
+                format!(
+                    "`{key}` reads {} signals; at most {}",
+                    inputs.len(),
+                    bondgraph::element::MAX_PARAM_INPUTS
+                ),
+            ));
+        }
         let compiled = exprs
             .iter()
             .map(|e| {

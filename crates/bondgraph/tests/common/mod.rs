@@ -197,8 +197,72 @@ pub fn planar_matrix_mtf() -> StateEquations {
     assemble(g)
 }
 
+/// A lever used the other way round: `spring` (C, 1/k) on `j1` at side 1, `mass` (I, m) on
+/// `j2` at side 2 of `tf` (ratio n). The mass sets the flow of side 2, so the TF computes
+/// e2 = e1/n and f1 = f2/n (its inverse orientation).
+pub fn reversed_lever(n: f64, m: f64, k: f64, q0: f64) -> StateEquations {
+    let mut g = BondGraph::new();
+    let j1 = g.add("j1", OneJunction).unwrap();
+    let c = g
+        .add("spring", Capacitor::new(1.0 / k, q0).unwrap())
+        .unwrap();
+    let t = g.add("tf", Transformer::new(n).unwrap()).unwrap();
+    let j2 = g.add("j2", OneJunction).unwrap();
+    let i = g.add("mass", Inertia::new(m, 0.0).unwrap()).unwrap();
+    g.connect((j1, None), (c, Some(0))).unwrap();
+    g.connect((j1, None), (t, Some(0))).unwrap();
+    g.connect((t, Some(1)), (j2, None)).unwrap();
+    g.connect((j2, None), (i, Some(0))).unwrap();
+    assemble(g)
+}
+
+/// Two compliances coupled by a gyrator (modulus r): `C1` on `z1`, `C2` on `z2`, both setting
+/// their efforts, so the GY is in admittance causality (f_in2 = −e1/r, f_in1 = e2/r).
+pub fn gyrator_between_capacitors(r: f64, c1: f64, c2: f64, q10: f64) -> StateEquations {
+    let mut g = BondGraph::new();
+    g.add("z1", ZeroJunction).unwrap();
+    g.add("C1", Capacitor::new(c1, q10).unwrap()).unwrap();
+    g.add("gy", Gyrator::new(r).unwrap()).unwrap();
+    g.add("z2", ZeroJunction).unwrap();
+    g.add("C2", Capacitor::new(c2, 0.0).unwrap()).unwrap();
+    bond_all(
+        &mut g,
+        &[("z1", "C1"), ("z1", "gy"), ("gy", "z2"), ("z2", "C2")],
+    );
+    assemble(g)
+}
+
+/// A planar point mass (m, initial momentum `p0`) on a spring (k) acting along the fixed unit
+/// direction u = (0.6, 0.8), through a constant 2×1 matrix MTF T = u.
+pub fn planar_constant_mtf(m: f64, k: f64, p0: [f64; 2], q0: f64) -> StateEquations {
+    let mut g = BondGraph::new();
+    let jm = g.add("jm", OneJunction).unwrap();
+    let mass = g
+        .add("mass", Inertia::multi(m, p0.to_vec()).unwrap())
+        .unwrap();
+    let law = boxed_law(|_, t| {
+        set(t, (0, 0), 0.6);
+        set(t, (1, 0), 0.8);
+    });
+    let mtf = g
+        .add("mtf", MatrixTransformer::new(2, 1, vec![], law).unwrap())
+        .unwrap();
+    let z = g.add("z", ZeroJunction).unwrap();
+    let c = g
+        .add("spring", Capacitor::new(1.0 / k, q0).unwrap())
+        .unwrap();
+    g.connect((jm, None), (mass, Some(0))).unwrap();
+    g.connect((jm, None), (mtf, Some(0))).unwrap();
+    g.connect((mtf, Some(1)), (z, None)).unwrap();
+    g.connect((z, None), (c, Some(0))).unwrap();
+    assemble(g)
+}
+
+/// A boxed matrix-modulus law (the matrix type is inferred where it is used).
+pub type BoxedLaw<T> = Box<dyn Fn(&Io<'_>, &mut T)>;
+
 /// Box a matrix-modulus law without naming the matrix type.
-pub fn boxed_law<T>(f: impl Fn(&Io<'_>, &mut T) + 'static) -> Box<dyn Fn(&Io<'_>, &mut T)> {
+pub fn boxed_law<T>(f: impl Fn(&Io<'_>, &mut T) + 'static) -> BoxedLaw<T> {
     Box::new(f)
 }
 
