@@ -45,4 +45,6 @@ pub mod registry;
 
 pub use error::{ErrorKind, ModelError};
 pub use load::{inspect, Check, CheckResult, Inspection, Model};
-pub use registry::{BuildFn, ElementSpec, KindInfo, RawValue, Registry};
+pub use registry::{
+    BuildFn, Builder, Composite, CompositeFn, ElementSpec, KindInfo, RawValue, Registry,
+};

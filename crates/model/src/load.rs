@@ -105,6 +105,16 @@ struct ElementDef {
     params: IndexMap<String, RawValue>,
     name_span: Range<usize>,
     used: HashSet<String>,
+    /// Global names of the elements this entry became (itself, or a composite's members).
+    members: Vec<String>,
+    /// A composite's exposed ports: name → `member` or `member.port` (global names).
+    ports: Vec<(String, String)>,
+}
+
+/// What one model-file entry builds into.
+enum BuiltDef {
+    One(Box<dyn Element>),
+    Many(crate::registry::Composite),
 }
 
 #[derive(Clone, Debug)]
@@ -138,7 +148,7 @@ impl Source {
     fn element_pos(&self, name: &str) -> Option<(usize, usize)> {
         self.elements
             .iter()
-            .find(|e| e.name == name)
+            .find(|e| e.name == name || e.members.iter().any(|m| m == name))
             .map(|e| line_col(&self.text, e.name_span.start))
     }
 
@@ -252,7 +262,7 @@ impl Source {
         &self,
         def: &ElementDef,
         constants: &IndexMap<String, f64>,
-    ) -> Result<(Box<dyn Element>, HashSet<String>), ModelError> {
+    ) -> Result<(BuiltDef, HashSet<String>), ModelError> {
         let info = self.registry.get(&def.kind).ok_or_else(|| {
             let mut kinds: Vec<&str> = self.registry.kinds().map(|(k, _)| k).collect();
             kinds.sort_unstable();
@@ -291,7 +301,10 @@ impl Source {
             asked: RefCell::new(Vec::new()),
             used_constants: RefCell::new(HashSet::new()),
         };
-        let element = (info.build)(&spec)?;
+        let element = match info.build {
+            crate::registry::Builder::Element(f) => BuiltDef::One(f(&spec)?),
+            crate::registry::Builder::Composite(f) => BuiltDef::Many(f(&spec)?),
+        };
         let (unused, asked) = spec.unused();
         if let Some(k) = unused.first() {
             let close = asked.iter().find(|a| {
@@ -313,6 +326,90 @@ impl Source {
                 .hint(hint));
         }
         Ok((element, spec.used_constants.into_inner()))
+    }
+}
+
+impl Source {
+    /// Build `def` with `constants` into global members (name, element); a composite's
+    /// internal bonds and exposed ports are returned in global names.
+    #[allow(clippy::type_complexity)]
+    fn build_members(
+        &self,
+        def: &ElementDef,
+        constants: &IndexMap<String, f64>,
+    ) -> Result<
+        (
+            Vec<(String, Box<dyn Element>)>,
+            Vec<(String, String, String)>,
+            Vec<(String, String)>,
+            HashSet<String>,
+        ),
+        ModelError,
+    > {
+        let (built, used) = self.build_element(def, constants)?;
+        match built {
+            BuiltDef::One(e) => Ok((vec![(def.name.clone(), e)], Vec::new(), Vec::new(), used)),
+            BuiltDef::Many(c) => {
+                let global = |local: &str| format!("{}_{local}", def.name);
+                let global_end = |end: &str| match end.split_once('.') {
+                    Some((el, port)) => format!("{}.{port}", global(el)),
+                    None => global(end),
+                };
+                let members = c
+                    .elements
+                    .into_iter()
+                    .map(|(n, e)| (global(&n), e))
+                    .collect();
+                let bonds = c
+                    .bonds
+                    .iter()
+                    .map(|(n, a, b)| (global(n), global_end(a), global_end(b)))
+                    .collect();
+                let ports = c
+                    .ports
+                    .iter()
+                    .map(|(n, inner)| (n.clone(), global_end(inner)))
+                    .collect();
+                Ok((members, bonds, ports, used))
+            }
+        }
+    }
+
+    /// Elements rebuilt with `constants`, as (element id, element), for every entry that
+    /// uses one of `changed` (all entries if `changed` is `None`).
+    fn rebuild(
+        &self,
+        eqs: &StateEquations,
+        constants: &IndexMap<String, f64>,
+        changed: Option<&HashSet<&String>>,
+        span: Option<&Range<usize>>,
+    ) -> Result<Vec<(usize, Box<dyn Element>)>, ModelError> {
+        let mut out = Vec::new();
+        for def in &self.elements {
+            if changed.is_some_and(|c| !def.used.iter().any(|u| c.contains(u))) {
+                continue;
+            }
+            let (members, _, _, _) = self.build_members(def, constants)?;
+            for (name, el) in members {
+                let id = eqs.graph().find(&name).ok_or_else(|| {
+                    self.err(
+                        ErrorKind::Settings,
+                        span,
+                        format!(
+                            "rebuilding `{}` gave a member `{name}` the model does not have",
+                            def.name
+                        ),
+                    )
+                    .element(&def.name)
+                })?;
+                eqs.check_replacement(id, el.as_ref()).map_err(|e| {
+                    self.err(ErrorKind::Settings, span, e.to_string())
+                        .element(&def.name)
+                })?;
+                out.push((id, el));
+            }
+        }
+        Ok(out)
     }
 }
 
@@ -459,6 +556,8 @@ fn parse(
             params,
             name_span: name.span(),
             used: HashSet::new(),
+            members: vec![n.clone()],
+            ports: Vec::new(),
         });
     }
     for ev in &spec.events {
@@ -483,15 +582,46 @@ fn parse(
 
 fn build_graph(p: &mut Parsed) -> Result<BondGraph, ModelError> {
     let mut g = BondGraph::new();
+    let mut internal = Vec::new();
     for i in 0..p.source.elements.len() {
         let def = p.source.elements[i].clone();
-        let (element, used) = p.source.build_element(&def, &p.parameters)?;
-        p.source.elements[i].used = used;
-        g.add_boxed(&def.name, element).map_err(|e| {
+        let (members, bonds, ports, used) = p.source.build_members(&def, &p.parameters)?;
+        let d = &mut p.source.elements[i];
+        d.used = used;
+        d.members = members.iter().map(|(n, _)| n.clone()).collect();
+        d.ports = ports;
+        for (name, element) in members {
+            g.add_boxed(&name, element).map_err(|e| {
+                p.source
+                    .err(ErrorKind::Graph, Some(&def.name_span), e.to_string())
+                    .element(&def.name)
+            })?;
+        }
+        internal.extend(bonds.into_iter().map(|b| (i, b)));
+    }
+    for (i, (name, from, to)) in internal {
+        let def = &p.source.elements[i];
+        let err = |e: String| {
             p.source
-                .err(ErrorKind::Graph, Some(&def.name_span), e.to_string())
+                .err(
+                    ErrorKind::Graph,
+                    Some(&def.name_span),
+                    format!("inside {} `{}`: bond {name}: {e}", def.kind, def.name),
+                )
                 .element(&def.name)
-        })?;
+        };
+        let end = |s: &str| -> Result<(usize, Option<usize>), ModelError> {
+            let (el, port) = s.split_once('.').map_or((s, None), |(e, p)| (e, Some(p)));
+            let id = g.find(el).ok_or_else(|| err(format!("no member `{el}`")))?;
+            let port = port
+                .map(|p| g.port_index(id, p))
+                .transpose()
+                .map_err(|e| err(e.to_string()))?;
+            Ok((id, port))
+        };
+        let (f, t) = (end(&from)?, end(&to)?);
+        g.connect_named(&name, f, t)
+            .map_err(|e| err(e.to_string()))?;
     }
     for (name, text) in &p.spec.bonds {
         let src = &p.source;
@@ -513,10 +643,40 @@ fn build_graph(p: &mut Parsed) -> Result<BondGraph, ModelError> {
         })?;
         let end = |s: &str| -> Result<(usize, Option<usize>), ModelError> {
             let s = s.trim();
-            let (el, port) = match s.split_once('.') {
+            let (mut el, mut port) = match s.split_once('.') {
                 Some((e, p)) => (e, Some(p)),
                 None => (s, None),
             };
+            // A composite stands for the member port it exposes.
+            let inner: String;
+            if let Some(def) = src
+                .elements
+                .iter()
+                .find(|d| d.name == el && !d.ports.is_empty())
+            {
+                let exposed: Vec<&str> = def.ports.iter().map(|(n, _)| n.as_str()).collect();
+                let pick = match port {
+                    Some(p) => def.ports.iter().find(|(n, _)| n == p),
+                    None if def.ports.len() == 1 => def.ports.first(),
+                    None => None,
+                };
+                let (_, target) = pick.ok_or_else(|| {
+                    err(
+                        ErrorKind::Graph,
+                        format!("{} `{el}` has no port `{}`", def.kind, port.unwrap_or("")),
+                    )
+                    .element(el)
+                    .hint(format!(
+                        "its ports are: {} (write `{el}.<port>`)",
+                        exposed.join(", ")
+                    ))
+                })?;
+                inner = target.clone();
+                (el, port) = match inner.split_once('.') {
+                    Some((e, p)) => (e, Some(p)),
+                    None => (inner.as_str(), None),
+                };
+            }
             let id = g.find(el).ok_or_else(|| {
                 let mut known: Vec<&str> = src.elements.iter().map(|e| e.name.as_str()).collect();
                 known.sort_unstable();
@@ -953,20 +1113,9 @@ impl Model {
                 .filter(|(k, v)| current.get(*k) != Some(*v))
                 .map(|(k, _)| k)
                 .collect();
-            let mut replacements = Vec::new();
-            for (id, def) in self.source.elements.iter().enumerate() {
-                if def.used.iter().any(|u| changed.contains(u)) {
-                    let (el, _) = self.source.build_element(def, &values)?;
-                    self.equations
-                        .check_replacement(id, el.as_ref())
-                        .map_err(|e| {
-                            self.source
-                                .err(ErrorKind::Settings, Some(&ev.span), e.to_string())
-                                .element(&def.name)
-                        })?;
-                    replacements.push((id, el));
-                }
-            }
+            let replacements =
+                self.source
+                    .rebuild(&self.equations, &values, Some(&changed), Some(&ev.span))?;
             current = values;
             events.push(Event {
                 t: ev.t,
@@ -990,8 +1139,10 @@ impl Model {
             events,
         );
         if has_events {
-            for (id, def) in self.source.elements.iter().enumerate() {
-                let (el, _) = self.source.build_element(def, &self.parameters)?;
+            for (id, el) in self
+                .source
+                .rebuild(&self.equations, &self.parameters, None, None)?
+            {
                 self.equations
                     .replace(id, el)
                     .map_err(|e| self.source.err(ErrorKind::Settings, None, e.to_string()))?;

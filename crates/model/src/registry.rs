@@ -15,11 +15,60 @@ use crate::expr::{Compiled, Expr};
 /// Builds an element from its parameters.
 pub type BuildFn = fn(&ElementSpec<'_>) -> Result<Box<dyn Element>, ModelError>;
 
+/// Builds a composite (a sub-graph) from its parameters.
+pub type CompositeFn = fn(&ElementSpec<'_>) -> Result<Composite, ModelError>;
+
+/// A sub-graph that one model-file entry expands into: a cylinder with its chambers, pistons
+/// and leakage; a manipulator with its fields.
+///
+/// Members are named locally (`piston_chamber`); in the model they become
+/// `<instance>_<local>` (`cyl1_piston_chamber`), so `bg-sim check` lists them all and their
+/// states and signals are addressed as `cyl1_piston_chamber.p`. Use
+/// [`ElementSpec::member`] to form those global names inside signal references.
+#[derive(Debug, Default)]
+pub struct Composite {
+    /// Members: local name and element.
+    pub elements: Vec<(String, Box<dyn Element>)>,
+    /// Internal bonds: local bond name, from and to as `local` or `local.port`.
+    pub bonds: Vec<(String, String, String)>,
+    /// Exposed ports: the name the model file uses (`cyl1.mech`) and the member port it
+    /// stands for (`local` or `local.port`), which must be left unbonded inside.
+    pub ports: Vec<(String, String)>,
+}
+
+impl Composite {
+    /// Add a member.
+    pub fn element(&mut self, local: &str, element: impl Element + 'static) -> &mut Self {
+        self.elements.push((local.to_owned(), Box::new(element)));
+        self
+    }
+    /// Add an internal bond `from -> to` (local names, `name.port` for a port).
+    pub fn bond(&mut self, name: &str, from: &str, to: &str) -> &mut Self {
+        self.bonds
+            .push((name.to_owned(), from.to_owned(), to.to_owned()));
+        self
+    }
+    /// Expose the member port `inner` as `name`.
+    pub fn port(&mut self, name: &str, inner: &str) -> &mut Self {
+        self.ports.push((name.to_owned(), inner.to_owned()));
+        self
+    }
+}
+
+/// How a kind is built.
+#[derive(Clone, Copy, Debug)]
+pub enum Builder {
+    /// One element.
+    Element(BuildFn),
+    /// A sub-graph.
+    Composite(CompositeFn),
+}
+
 /// A registered element kind.
 #[derive(Clone, Debug)]
 pub struct KindInfo {
     /// The builder.
-    pub build: BuildFn,
+    pub build: Builder,
     /// One line for `bg-sim kinds` and error hints.
     pub summary: &'static str,
 }
@@ -47,8 +96,24 @@ impl Registry {
 
     /// Register `kind`; a later registration of the same name replaces the earlier one.
     pub fn register(&mut self, kind: &str, summary: &'static str, build: BuildFn) {
-        self.kinds
-            .insert(kind.to_owned(), KindInfo { build, summary });
+        self.kinds.insert(
+            kind.to_owned(),
+            KindInfo {
+                build: Builder::Element(build),
+                summary,
+            },
+        );
+    }
+
+    /// Register a composite `kind` that expands into a sub-graph ([`Composite`]).
+    pub fn register_composite(&mut self, kind: &str, summary: &'static str, build: CompositeFn) {
+        self.kinds.insert(
+            kind.to_owned(),
+            KindInfo {
+                build: Builder::Composite(build),
+                summary,
+            },
+        );
     }
 
     /// The kind called `kind`.
@@ -120,6 +185,19 @@ impl ElementSpec<'_> {
         };
         self.error(key, ErrorKind::BadParameter, format!("({}) {e}", self.kind))
             .hint(format!("fix `{key}` of `{}`", self.name))
+    }
+
+    /// The global name of member `local` of this composite: `<instance>_<local>`.
+    #[must_use]
+    pub fn member(&self, local: &str) -> String {
+        format!("{}_{local}", self.name)
+    }
+
+    /// The raw TOML value of `key`, for builders that read nested tables or arrays themselves
+    /// (report problems with [`error`](Self::error) on the same key).
+    #[must_use]
+    pub fn raw(&self, key: &str) -> Option<&toml::Value> {
+        self.ask(key).map(|r| &r.value)
     }
 
     /// Whether `key` is given.
