@@ -188,6 +188,16 @@ fn run(
             target.display()
         );
     }
+    for w in &outcome.watched {
+        if let Some(warning) = &w.warning {
+            eprintln!("warning: {warning}");
+        } else if !quiet {
+            println!(
+                "minimum {} of {}: {:.6e} at t = {:.6} s",
+                w.name, w.element, w.min, w.t_min
+            );
+        }
+    }
     let mut code = ExitCode::SUCCESS;
     if let Some(e) = &outcome.error {
         eprintln!("error: {}: the run stopped early: {e}", model.file());

@@ -243,11 +243,30 @@ pub trait Element: Debug {
         let _ = (io, dx);
     }
 
+    /// States the simulator should watch over a run, every accepted step (a chamber's
+    /// minimum pressure, with a warning below the tank pressure).
+    fn watches(&self) -> Vec<Watch> {
+        Vec::new()
+    }
+
     /// Energy stored at states `x` (for energy-balance tests), if the element stores any.
     fn stored_energy(&self, x: &[f64]) -> Option<f64> {
         let _ = x;
         None
     }
+}
+
+/// A state whose minimum the simulator records over a run, at every accepted step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Watch {
+    /// What it is, for the report (`pressure`).
+    pub name: String,
+    /// Index of the state within the element's states.
+    pub state: usize,
+    /// Warn when the minimum falls below this value.
+    pub warn_below: Option<f64>,
+    /// The warning's text (why it matters), e.g. "cavitation, which the model does not represent".
+    pub warning: String,
 }
 
 /// Where a signal input comes from.

@@ -59,10 +59,12 @@ pub mod simulate;
 pub use bond::{Bond, BondId, ElementId, Endpoint, PortCausality};
 pub use causality::{assign_causality, CausalGraph};
 pub use element::{
-    CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Slot, Stage, StateSpec,
+    CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Slot, Stage, StateSpec, Watch,
 };
 pub use elements::*;
 pub use equations::{Probe, StateEquations, StateInfo};
 pub use error::{CausalityError, Error, GraphError, ParamError, SimulationError};
 pub use graph::{BondGraph, Node};
-pub use simulate::{simulate, Event, Method, Outcome, Output, Settings, Statistics, Trajectory};
+pub use simulate::{
+    simulate, Event, Method, Outcome, Output, Settings, Statistics, Trajectory, WatchReport,
+};

@@ -221,6 +221,88 @@ pub struct Outcome {
     pub x_final: Vec<f64>,
     /// Why the run stopped early, if it did.
     pub error: Option<SimulationError>,
+    /// The watched states' minima over every accepted step.
+    pub watched: Vec<WatchReport>,
+}
+
+/// The minimum a watched state reached.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WatchReport {
+    /// The element.
+    pub element: String,
+    /// The state's global name (`cyl1_piston_chamber.p`).
+    pub state: String,
+    /// What it is (`pressure`).
+    pub name: String,
+    /// Minimum over every accepted step.
+    pub min: f64,
+    /// When it was reached.
+    pub t_min: f64,
+    /// A warning, if the minimum fell below the element's threshold.
+    pub warning: Option<String>,
+}
+
+struct Watcher {
+    index: usize,
+    report: WatchReport,
+    warn_below: Option<f64>,
+    warning: String,
+}
+
+fn watchers(eqs: &StateEquations) -> Vec<Watcher> {
+    let mut v = Vec::new();
+    for id in 0..eqs.graph().n_elements() {
+        let node = eqs.graph().node(id);
+        let Some(first) = eqs.states().iter().position(|s| s.element == id) else {
+            continue;
+        };
+        for w in node.element.watches() {
+            let index = first + w.state;
+            let Some(info) = eqs.states().get(index) else {
+                continue;
+            };
+            v.push(Watcher {
+                index,
+                report: WatchReport {
+                    element: node.name.clone(),
+                    state: info.name.clone(),
+                    name: w.name,
+                    min: f64::INFINITY,
+                    t_min: f64::NAN,
+                    warning: None,
+                },
+                warn_below: w.warn_below,
+                warning: w.warning,
+            });
+        }
+    }
+    v
+}
+
+fn watch(w: &mut [Watcher], t: f64, x: &[f64]) {
+    for w in w {
+        if x[w.index] < w.report.min {
+            w.report.min = x[w.index];
+            w.report.t_min = t;
+        }
+    }
+}
+
+fn reports(w: Vec<Watcher>) -> Vec<WatchReport> {
+    w.into_iter()
+        .map(|w| {
+            let mut r = w.report;
+            if let Some(lim) = w.warn_below {
+                if r.min < lim {
+                    r.warning = Some(format!(
+                        "{} of `{}` fell to {:.6e} at t = {:.6} s, below {lim:e}: {}",
+                        r.name, r.element, r.min, r.t_min, w.warning
+                    ));
+                }
+            }
+            r
+        })
+        .collect()
 }
 
 /// A named output column.
@@ -234,6 +316,7 @@ pub struct Output {
 
 struct Recorder<'e> {
     eqs: &'e StateEquations,
+    watchers: Vec<Watcher>,
     outputs: &'e [Output],
     grid: Vec<f64>,
     next: usize,
@@ -288,6 +371,7 @@ pub fn simulate(
         t_final: settings.t_start,
         x_final: x0.to_vec(),
         error: None,
+        watched: Vec::new(),
     };
     if let Err(e) = settings.validate() {
         out.error = Some(e);
@@ -326,6 +410,8 @@ pub fn simulate(
     let mut t = t0;
     let mut events = events.into_iter().peekable();
     let mut rows = Vec::new();
+    let mut watchers = watchers(eqs);
+    watch(&mut watchers, t0, x0);
     loop {
         // Apply every event due now.
         while let Some(ev) = events.next_if(|e| e.t <= t || same_time(e.t, t)) {
@@ -350,6 +436,7 @@ pub fn simulate(
         }
         let mut rec = Recorder {
             eqs,
+            watchers: std::mem::take(&mut watchers),
             outputs,
             grid: std::mem::take(&mut grid),
             next: 0,
@@ -363,11 +450,13 @@ pub fn simulate(
         let t_stop = events.peek().map_or(t_end, |e| e.t.min(t_end));
         if t >= t_end || same_time(t, t_end) {
             rows = rec.rows;
+            watchers = rec.watchers;
             break;
         }
         let seg = run_segment(&mut rec, settings, t, t_stop, &x, &mut out.stats);
         grid = rec.grid;
         rows = rec.rows;
+        watchers = rec.watchers;
         match seg {
             Ok(xs) => {
                 x = xs;
@@ -382,6 +471,7 @@ pub fn simulate(
         }
     }
     out.trajectory.rows = rows;
+    out.watched = reports(watchers);
     out.t_final = t;
     out.x_final = x;
     out.stats.wall_time = start.elapsed();
@@ -579,6 +669,7 @@ where
                 ));
             }
             Ok(reason) => {
+                watch(&mut rec.watchers, t, &x);
                 if let Some(i) = x.iter().position(|v| !v.is_finite()) {
                     finish(&s, stats);
                     let info = &eqs.states()[i];
