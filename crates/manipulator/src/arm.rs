@@ -1,0 +1,338 @@
+//! [`PlanarArm`]: a planar serial chain of links joined by revolute joints, its generalized
+//! coordinates, and its configuration ([`Pose`]) at given coordinates.
+//!
+//! # Generalized coordinates (eq. 32)
+//! `q = [q_1 … q_{n_q}, q^{b1} …, q^{b n_q} …]`: first one chord-to-chord joint angle per
+//! link, then the modal coordinates of each link in link order (a rigid link has none). The
+//! knuckle boom of the design page has `q = [q1, q2, q3, qb1_1..3, qb2_1..3]`.
+//!
+//! # Frames
+//! Frame 0 is inertial with gravity along −y₀. Frame i sits at joint i: at the origin of
+//! frame 0 for i = 1, at the end of link i−1's chord otherwise; its x axis runs along link
+//! i's chord at the angle `φ_i = q_1 + … + q_i` from x₀.
+
+use nalgebra::Vector2;
+
+use crate::error::ManipulatorError;
+use crate::joint::RevoluteJoint;
+use crate::link::Link;
+use crate::pin::Pin;
+use crate::quadrature::GaussLegendre;
+
+/// A point on a link's axis at distance `x` along its chord, with the mode shapes evaluated
+/// there (`ψ_k(x)`, `θ_k(x)`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Station {
+    /// Link index, 0-based.
+    pub link: usize,
+    /// Distance along the chord (m).
+    pub x: f64,
+    pub(crate) psi: Vec<f64>,
+    pub(crate) theta: Vec<f64>,
+}
+
+/// A station carrying mass: a quadrature point of a link (mass `w·ρA`, rotary inertia `w·ρI`)
+/// or a point mass.
+#[derive(Clone, Debug)]
+pub(crate) struct MassStation {
+    pub(crate) station: Station,
+    pub(crate) mass: f64,
+    pub(crate) inertia: f64,
+}
+
+/// A planar serial manipulator.
+#[derive(Clone, Debug)]
+pub struct PlanarArm {
+    links: Vec<Link>,
+    joint: RevoluteJoint,
+    gravity: f64,
+    quadrature: GaussLegendre,
+    modal_offset: Vec<usize>,
+    n: usize,
+    mass_stations: Vec<MassStation>,
+}
+
+impl PlanarArm {
+    /// A chain of `links` (at least one) under gravity `gravity` (m/s², along −y₀), with the
+    /// default quadrature ([`GaussLegendre::DEFAULT_POINTS`] points per link).
+    pub fn new(links: Vec<Link>, gravity: f64) -> Result<Self, ManipulatorError> {
+        Self::with_quadrature(links, gravity, GaussLegendre::DEFAULT_POINTS)
+    }
+
+    /// As [`new`](Self::new) with `points` Gauss–Legendre points per link.
+    pub fn with_quadrature(
+        links: Vec<Link>,
+        gravity: f64,
+        points: usize,
+    ) -> Result<Self, ManipulatorError> {
+        if links.is_empty() {
+            return Err(ManipulatorError::shape("links", "an arm needs at least one link"));
+        }
+        ManipulatorError::finite("gravity", gravity)?;
+        let quadrature = GaussLegendre::new(points)?;
+        let mut modal_offset = Vec::with_capacity(links.len());
+        let mut n = links.len();
+        for l in &links {
+            modal_offset.push(n);
+            n += l.modes().len();
+        }
+        let mut arm = Self {
+            links,
+            joint: RevoluteJoint,
+            gravity,
+            quadrature,
+            modal_offset,
+            n,
+            mass_stations: Vec::new(),
+        };
+        arm.mass_stations = arm.build_mass_stations();
+        Ok(arm)
+    }
+
+    fn build_mass_stations(&self) -> Vec<MassStation> {
+        let mut out = Vec::new();
+        for (i, link) in self.links.iter().enumerate() {
+            if link.has_distributed_mass() {
+                for (x, w) in self.quadrature.on(link.length()) {
+                    out.push(MassStation {
+                        station: self.station_unchecked(i, x),
+                        mass: w * link.mass_per_length(),
+                        inertia: w * link.rotary_inertia_per_length(),
+                    });
+                }
+            }
+            for m in link.point_masses() {
+                out.push(MassStation {
+                    station: self.station_unchecked(i, m.x),
+                    mass: m.mass,
+                    inertia: m.inertia,
+                });
+            }
+        }
+        out
+    }
+
+    /// Number of generalized coordinates n.
+    #[must_use]
+    pub fn n(&self) -> usize {
+        self.n
+    }
+    /// Number of links (= joints).
+    #[must_use]
+    pub fn n_links(&self) -> usize {
+        self.links.len()
+    }
+    /// The links.
+    #[must_use]
+    pub fn links(&self) -> &[Link] {
+        &self.links
+    }
+    /// The joints' common description.
+    #[must_use]
+    pub fn joint(&self) -> &RevoluteJoint {
+        &self.joint
+    }
+    /// Gravity (m/s², along −y₀).
+    #[must_use]
+    pub fn gravity(&self) -> f64 {
+        self.gravity
+    }
+    /// The quadrature rule used along every link.
+    #[must_use]
+    pub fn quadrature(&self) -> &GaussLegendre {
+        &self.quadrature
+    }
+    /// Index in q of the first modal coordinate of link `i`.
+    #[must_use]
+    pub fn modal_offset(&self, i: usize) -> usize {
+        self.modal_offset[i]
+    }
+    /// Total mass of the arm (kg).
+    #[must_use]
+    pub fn mass(&self) -> f64 {
+        self.links.iter().map(Link::mass).sum()
+    }
+    pub(crate) fn mass_stations(&self) -> &[MassStation] {
+        &self.mass_stations
+    }
+
+    /// A line of names for q: `q1.., qb1_1..` (1-based, as in the design page).
+    #[must_use]
+    pub fn coordinate_names(&self) -> Vec<String> {
+        let mut names: Vec<String> = (1..=self.links.len()).map(|i| format!("q{i}")).collect();
+        for (i, l) in self.links.iter().enumerate() {
+            names.extend((1..=l.modes().len()).map(|k| format!("qb{}_{k}", i + 1)));
+        }
+        names
+    }
+
+    /// The station at distance `x` along link `link`'s chord.
+    pub fn station(&self, link: usize, x: f64) -> Result<Station, ManipulatorError> {
+        let l = self.links.get(link).ok_or_else(|| {
+            ManipulatorError::shape(
+                "link",
+                format!("link {} does not exist (the arm has {})", link + 1, self.links.len()),
+            )
+        })?;
+        if !(x.is_finite() && (0.0..=l.length()).contains(&x)) {
+            return Err(ManipulatorError::invalid("x", x, "on the link, 0 <= x <= L"));
+        }
+        Ok(self.station_unchecked(link, x))
+    }
+
+    fn station_unchecked(&self, link: usize, x: f64) -> Station {
+        let modes = self.links[link].modes();
+        Station {
+            link,
+            x,
+            psi: modes.iter().map(|m| m.value(x)).collect(),
+            theta: modes.iter().map(|m| m.slope(x)).collect(),
+        }
+    }
+
+    /// Check a pin lies on the arm (or is a finite ground point).
+    pub fn check_pin(&self, pin: &Pin) -> Result<(), ManipulatorError> {
+        match *pin {
+            Pin::Ground(p) => {
+                ManipulatorError::finite("pin.x", p.x)?;
+                ManipulatorError::finite("pin.y", p.y)?;
+                Ok(())
+            }
+            Pin::Link { link, x } => self.station(link, x).map(|_| ()),
+        }
+    }
+
+    /// The configuration at `q`.
+    ///
+    /// # Panics
+    /// If `q.len() != self.n()`.
+    #[must_use]
+    pub fn pose<'a>(&'a self, q: &'a [f64]) -> Pose<'a> {
+        assert_eq!(q.len(), self.n, "q has {} entries, the arm {}", q.len(), self.n);
+        let nl = self.links.len();
+        let mut phi = Vec::with_capacity(nl);
+        let mut origin = Vec::with_capacity(nl + 1);
+        let (mut a, mut o) = (0.0, Vector2::zeros());
+        for (i, link) in self.links.iter().enumerate() {
+            a += q[i];
+            phi.push(a);
+            origin.push(o);
+            o += link.length() * Vector2::new(a.cos(), a.sin());
+        }
+        origin.push(o);
+        Pose {
+            arm: self,
+            q,
+            phi,
+            origin,
+        }
+    }
+}
+
+/// The arm at one configuration q: chord angles, joint positions, deflections.
+#[derive(Clone, Debug)]
+pub struct Pose<'a> {
+    arm: &'a PlanarArm,
+    q: &'a [f64],
+    phi: Vec<f64>,
+    origin: Vec<Vector2<f64>>,
+}
+
+impl<'a> Pose<'a> {
+    /// The arm.
+    #[must_use]
+    pub fn arm(&self) -> &'a PlanarArm {
+        self.arm
+    }
+    /// The coordinates.
+    #[must_use]
+    pub fn q(&self) -> &[f64] {
+        self.q
+    }
+    /// Angle φ_i of link i's chord from x₀.
+    #[must_use]
+    pub fn chord_angle(&self, i: usize) -> f64 {
+        self.phi[i]
+    }
+    /// Position of joint i (origin of frame i) in frame 0; `origin(n_links)` is the end of
+    /// the last chord.
+    #[must_use]
+    pub fn origin(&self, i: usize) -> Vector2<f64> {
+        self.origin[i]
+    }
+    /// The modal coordinates of link i.
+    #[must_use]
+    pub fn modal(&self, i: usize) -> &[f64] {
+        let o = self.arm.modal_offset[i];
+        &self.q[o..o + self.arm.links[i].modes().len()]
+    }
+    /// Deflection `w(x)` at a station.
+    #[must_use]
+    pub fn deflection(&self, s: &Station) -> f64 {
+        s.psi.iter().zip(self.modal(s.link)).map(|(p, q)| p * q).sum()
+    }
+    /// Rotation `θ(x) = w'(x)` of the cross-section at a station.
+    #[must_use]
+    pub fn slope(&self, s: &Station) -> f64 {
+        s.theta.iter().zip(self.modal(s.link)).map(|(p, q)| p * q).sum()
+    }
+    /// Position of a station in its link's frame: `(x, w(x))`.
+    #[must_use]
+    pub fn local(&self, s: &Station) -> Vector2<f64> {
+        Vector2::new(s.x, self.deflection(s))
+    }
+    /// Position of a station in frame 0.
+    #[must_use]
+    pub fn position(&self, s: &Station) -> Vector2<f64> {
+        self.origin[s.link] + rotate(self.phi[s.link], &self.local(s))
+    }
+    /// Position of a pin in frame 0 (a pin on a link sits on its deformed axis).
+    ///
+    /// # Panics
+    /// If the pin names a link the arm does not have ([`PlanarArm::check_pin`] first).
+    #[must_use]
+    pub fn pin_position(&self, pin: &Pin) -> Vector2<f64> {
+        match *pin {
+            Pin::Ground(p) => p,
+            Pin::Link { link, x } => self.position(&self.arm.station_unchecked(link, x)),
+        }
+    }
+}
+
+/// Rotate a planar vector by `angle`.
+#[must_use]
+pub(crate) fn rotate(angle: f64, v: &Vector2<f64>) -> Vector2<f64> {
+    let (s, c) = angle.sin_cos();
+    Vector2::new(c * v.x - s * v.y, s * v.x + c * v.y)
+}
+
+/// `ẑ × v` for a planar vector.
+#[must_use]
+pub(crate) fn z_cross(v: &Vector2<f64>) -> Vector2<f64> {
+    Vector2::new(-v.y, v.x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn coordinates_and_frames_of_the_knuckle_boom() {
+        let l1 = Link::beam(10.0, 210e9, 7850.0, 0.0264, 5.89e-4).unwrap().with_sine_modes(3).unwrap();
+        let l2 = Link::beam(8.0, 210e9, 7850.0, 0.0264, 5.89e-4).unwrap().with_sine_modes(3).unwrap();
+        let l3 = Link::pendulum(6.0, 5000.0).unwrap();
+        let arm = PlanarArm::new(vec![l1, l2, l3], 9.81).unwrap();
+        assert_eq!(arm.n(), 9);
+        assert_eq!(arm.coordinate_names()[3], "qb1_1");
+        assert_eq!(arm.modal_offset(1), 6);
+        let pi = std::f64::consts::PI;
+        let q = [0.0, -2.0 * pi / 3.0, pi / 6.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+        let pose = arm.pose(&q);
+        assert!((pose.origin(1) - Vector2::new(10.0, 0.0)).norm() < 1e-12);
+        assert!((pose.origin(2) - Vector2::new(6.0, -8.0 * (pi / 3.0).sin())).norm() < 1e-12);
+        // the pendulum hangs straight down
+        assert!((pose.chord_angle(2) + pi / 2.0).abs() < 1e-12);
+        assert!(arm.station(3, 1.0).is_err());
+        assert!(arm.station(0, 10.5).is_err());
+    }
+}

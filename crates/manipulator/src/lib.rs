@@ -1,0 +1,71 @@
+//! # bg-manipulator: planar flexible manipulators as bond-graph multiport fields
+//!
+//! Sections 2–5 of Cibicik, Pedersen & Egeland, *Dynamics of luffing motion of a flexible
+//! knuckle boom crane actuated by hydraulic cylinders* (Mech. Mach. Theory 2019), with the
+//! conventions of `shared/design/knuckle-boom.md`; `docs/manipulator.md` gives the
+//! formulation with the paper's equation numbers.
+//!
+//! ## Screw algebra (section 2)
+//! [`screw`]: twists, wrenches, joint lines, the transformations `U`, `R̄`, `V`
+//! ([`ReferenceTransform`], [`CoordinateTransform`], [`ScrewTransform`]) and `Π`
+//! ([`screw::interchange`]), planar motion embedded in 6-D as in the paper.
+//!
+//! ## The arm (section 3.1)
+//! [`Link`]s (rigid, Euler–Bernoulli beams with assumed [`ModeShape`]s — [`SineMode`] by
+//! default —, point masses, the payload pendulum) joined by [`RevoluteJoint`]s with
+//! chord-to-chord angles form a [`PlanarArm`]; [`PlanarArm::pose`] gives its [`Pose`] and
+//! [`Projection`] the projection matrices (eqs. 24, 38, 73), integrated along the links with
+//! [`GaussLegendre`] quadrature.
+//!
+//! ## Dynamics (section 3.2)
+//! [`PlanarArm::kinematics`] → [`ArmKinematics`]: the mass matrix
+//! ([`ArmKinematics::mass_matrix`], eq. 42), `E = ∂T/∂q` ([`ArmKinematics::kinetic_forces`],
+//! eq. 44), gravity ([`ArmKinematics::gravity_forces`], eqs. 45–48), the accelerations; the
+//! stiffness ([`PlanarArm::stiffness_matrix`], eq. 51).
+//!
+//! ## Actuators and lumped masses (sections 3.3, 4.2)
+//! [`LinearActuator`] between [`Pin`]s: length from the deformed pins and `τ_b = ∂l/∂q`
+//! ([`PlanarArm::actuator_jacobian`], eqs. 52–69); [`LumpedMass`] and `J_c`
+//! ([`PlanarArm::lumped_mass_jacobian`], eqs. 70–77).
+//!
+//! ## Reaction forces (section 5)
+//! [`ArmKinematics::reactions`] (eqs. 84–98) with [`PointLoad`]s.
+//!
+//! ## Bond-graph elements (section 4)
+//! [`elements`]: the I-field ([`ArmInertia`]), C-field ([`ArmCompliance`]), R-field
+//! ([`ArmDamping`]), the MTFs to the cylinders ([`ActuatorTransformer`]) and to the lumped
+//! masses ([`LumpedMassTransformer`]), the lumped masses themselves, and the reaction-force
+//! block ([`ArmReactions`]). [`ArmScene`] wires them into a graph; [`register`] offers the
+//! scene to model files as the composite kind `manipulator.planar_arm`.
+
+pub mod actuator;
+pub mod arm;
+pub mod error;
+pub mod gravity;
+pub mod joint;
+pub mod kinematics;
+pub mod kinetic_forces;
+pub mod link;
+pub mod lumped_mass;
+pub mod mass_matrix;
+pub mod mode_shape;
+pub mod pin;
+pub mod projection;
+pub mod quadrature;
+pub mod reactions;
+pub mod screw;
+pub mod stiffness;
+
+pub use actuator::LinearActuator;
+pub use arm::{PlanarArm, Pose, Station};
+pub use error::ManipulatorError;
+pub use joint::RevoluteJoint;
+pub use kinematics::ArmKinematics;
+pub use link::{Link, PointMass};
+pub use lumped_mass::LumpedMass;
+pub use mode_shape::{ModeShape, SineMode};
+pub use pin::Pin;
+pub use projection::Projection;
+pub use quadrature::GaussLegendre;
+pub use reactions::PointLoad;
+pub use screw::{CoordinateTransform, ReferenceTransform, ScrewTransform};

@@ -1,0 +1,224 @@
+//! Links: rigid bodies and flexible Euler–Bernoulli beams along a chord, with point masses.
+//!
+//! A link is described in its own frame i: the origin sits at the joint that carries it, the
+//! x axis runs along its chord, and the cross-section at distance x sits at `(x, w(x))` with
+//! `w(x) = Σ_k ψ_k(x) q_k^b` (section 3.1). Mass is distributed along the chord (mass per
+//! length ρA, rotary inertia per length ρI as in eq. 40) and/or lumped in [`PointMass`]es on
+//! the deformed axis. With no modes the link is rigid.
+//!
+//! ```text
+//!   joint i ●━━━━━━━━━━━━━━━━━━━━━━━━━━━━━● joint i+1     (chord, x → L)
+//!             ╲_________ w(x) ________╱                    (deformed axis)
+//! ```
+
+use std::sync::Arc;
+
+use crate::error::ManipulatorError;
+use crate::mode_shape::{ModeShape, SineMode};
+
+/// A point mass on the deformed axis of a link, at distance `x` along the chord.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointMass {
+    /// Position along the chord (m), `0 ≤ x ≤ L`.
+    pub x: f64,
+    /// Mass (kg), ≥ 0.
+    pub mass: f64,
+    /// Rotary inertia about its own z axis (kg·m²), ≥ 0; it turns with the cross-section.
+    pub inertia: f64,
+}
+
+/// One link of a planar serial manipulator.
+#[derive(Clone, Debug)]
+pub struct Link {
+    length: f64,
+    mass_per_length: f64,
+    rotary_inertia_per_length: f64,
+    bending_stiffness: f64,
+    modes: Vec<Arc<dyn ModeShape>>,
+    masses: Vec<PointMass>,
+}
+
+impl Link {
+    /// A rigid uniform link: length `length` (m, > 0), mass per length `mass_per_length`
+    /// (kg/m, ≥ 0).
+    pub fn rigid(length: f64, mass_per_length: f64) -> Result<Self, ManipulatorError> {
+        Ok(Self {
+            length: ManipulatorError::positive("length", length)?,
+            mass_per_length: ManipulatorError::non_negative("mass_per_length", mass_per_length)?,
+            rotary_inertia_per_length: 0.0,
+            bending_stiffness: 0.0,
+            modes: Vec::new(),
+            masses: Vec::new(),
+        })
+    }
+
+    /// A uniform Euler–Bernoulli beam of length `length`, Young's modulus `e` (Pa), density
+    /// `rho` (kg/m³), cross-section area `a` (m²) and second moment of area `i` (m⁴): mass
+    /// per length ρA, rotary inertia per length ρI (eq. 40), bending stiffness EI (eq. 50).
+    /// Rigid until modes are added ([`with_sine_modes`](Self::with_sine_modes)).
+    pub fn beam(length: f64, e: f64, rho: f64, a: f64, i: f64) -> Result<Self, ManipulatorError> {
+        let e = ManipulatorError::positive("E", e)?;
+        let rho = ManipulatorError::positive("rho", rho)?;
+        let a = ManipulatorError::positive("A", a)?;
+        let i = ManipulatorError::positive("I", i)?;
+        let mut link = Self::rigid(length, rho * a)?;
+        link.rotary_inertia_per_length = rho * i;
+        link.bending_stiffness = e * i;
+        Ok(link)
+    }
+
+    /// The payload pendulum: a rigid massless link of length `length` with a point mass
+    /// `mass` at its end (its frame's x axis points from the pivot to the payload).
+    pub fn pendulum(length: f64, mass: f64) -> Result<Self, ManipulatorError> {
+        Self::rigid(length, 0.0)?.with_point_mass(PointMass {
+            x: length,
+            mass,
+            inertia: 0.0,
+        })
+    }
+
+    /// Set the rotary inertia per length ρI (kg·m).
+    pub fn with_rotary_inertia(mut self, per_length: f64) -> Result<Self, ManipulatorError> {
+        self.rotary_inertia_per_length =
+            ManipulatorError::non_negative("rotary_inertia_per_length", per_length)?;
+        Ok(self)
+    }
+
+    /// Set the bending stiffness EI (N·m²).
+    pub fn with_bending_stiffness(mut self, ei: f64) -> Result<Self, ManipulatorError> {
+        self.bending_stiffness = ManipulatorError::non_negative("EI", ei)?;
+        Ok(self)
+    }
+
+    /// Add the first `n` hinged–hinged sine modes `sin(kπx/L)`, k = 1..n.
+    pub fn with_sine_modes(self, n: u32) -> Result<Self, ManipulatorError> {
+        let l = self.length;
+        (1..=n).try_fold(self, |link, k| {
+            link.with_mode(Arc::new(SineMode::new(k, l)))
+        })
+    }
+
+    /// Add an assumed mode. It must vanish at both ends of the chord (chord-to-chord joint
+    /// angles), and the link must have a bending stiffness.
+    pub fn with_mode(mut self, mode: Arc<dyn ModeShape>) -> Result<Self, ManipulatorError> {
+        ManipulatorError::positive("EI", self.bending_stiffness)?;
+        let scale = (0..=16)
+            .map(|k| mode.value(self.length * f64::from(k) / 16.0).abs())
+            .fold(0.0, f64::max)
+            .max(1.0);
+        for x in [0.0, self.length] {
+            let v = mode.value(x);
+            if !v.is_finite() || v.abs() > 1e-9 * scale {
+                return Err(ManipulatorError::shape(
+                    "modes",
+                    format!(
+                        "a mode must vanish at both ends of the chord (chord-to-chord joint angles), but ψ({x}) = {v}"
+                    ),
+                ));
+            }
+        }
+        self.modes.push(mode);
+        Ok(self)
+    }
+
+    /// Add a point mass on the deformed axis.
+    pub fn with_point_mass(mut self, m: PointMass) -> Result<Self, ManipulatorError> {
+        if !(m.x.is_finite() && (0.0..=self.length).contains(&m.x)) {
+            return Err(ManipulatorError::invalid(
+                "point_mass.x",
+                m.x,
+                "within the link, 0 <= x <= L",
+            ));
+        }
+        ManipulatorError::non_negative("point_mass.mass", m.mass)?;
+        ManipulatorError::non_negative("point_mass.inertia", m.inertia)?;
+        self.masses.push(m);
+        Ok(self)
+    }
+
+    /// Chord length L (m).
+    #[must_use]
+    pub fn length(&self) -> f64 {
+        self.length
+    }
+    /// Mass per length ρA (kg/m).
+    #[must_use]
+    pub fn mass_per_length(&self) -> f64 {
+        self.mass_per_length
+    }
+    /// Rotary inertia per length ρI (kg·m).
+    #[must_use]
+    pub fn rotary_inertia_per_length(&self) -> f64 {
+        self.rotary_inertia_per_length
+    }
+    /// Bending stiffness EI (N·m²).
+    #[must_use]
+    pub fn bending_stiffness(&self) -> f64 {
+        self.bending_stiffness
+    }
+    /// The assumed modes.
+    #[must_use]
+    pub fn modes(&self) -> &[Arc<dyn ModeShape>] {
+        &self.modes
+    }
+    /// The point masses.
+    #[must_use]
+    pub fn point_masses(&self) -> &[PointMass] {
+        &self.masses
+    }
+    /// Whether the link has no modes.
+    #[must_use]
+    pub fn is_rigid(&self) -> bool {
+        self.modes.is_empty()
+    }
+    /// Whether the link has distributed mass or rotary inertia to integrate.
+    #[must_use]
+    pub fn has_distributed_mass(&self) -> bool {
+        self.mass_per_length > 0.0 || self.rotary_inertia_per_length > 0.0
+    }
+    /// Total mass (kg).
+    #[must_use]
+    pub fn mass(&self) -> f64 {
+        self.mass_per_length * self.length + self.masses.iter().map(|m| m.mass).sum::<f64>()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn constructors_reject_bad_values() {
+        assert!(Link::rigid(0.0, 1.0).is_err());
+        assert!(Link::rigid(1.0, -1.0).is_err());
+        assert!(Link::beam(1.0, 210e9, 7850.0, 0.0, 1e-4).is_err());
+        assert!(Link::pendulum(6.0, f64::NAN).is_err());
+        assert!(Link::rigid(1.0, 1.0).unwrap().with_sine_modes(1).is_err()); // no EI
+        let l = Link::rigid(2.0, 1.0).unwrap();
+        assert!(l
+            .with_point_mass(PointMass { x: 2.5, mass: 1.0, inertia: 0.0 })
+            .is_err());
+    }
+
+    #[test]
+    fn modes_must_vanish_at_the_chord_ends() {
+        #[derive(Debug)]
+        struct Cantilever;
+        impl ModeShape for Cantilever {
+            fn value(&self, x: f64) -> f64 {
+                x * x
+            }
+            fn slope(&self, x: f64) -> f64 {
+                2.0 * x
+            }
+            fn curvature(&self, _: f64) -> f64 {
+                2.0
+            }
+        }
+        let beam = Link::beam(10.0, 210e9, 7850.0, 0.0264, 5.89e-4).unwrap();
+        assert!(beam.clone().with_mode(Arc::new(Cantilever)).is_err());
+        let b = beam.with_sine_modes(3).unwrap();
+        assert_eq!(b.modes().len(), 3);
+        assert!((b.mass() - 7850.0 * 0.0264 * 10.0).abs() < 1e-9);
+    }
+}

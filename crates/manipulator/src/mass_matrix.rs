@@ -1,0 +1,56 @@
+//! The mass matrix M(q) (eq. 42) and the kinetic energy T (eq. 41).
+//!
+//! `M = Σ_i ∫_0^{L_i} Pᵀ D_e P dx + Σ_point masses Pᵀ D P`, with `D_e = diag(ρJ, ρA I)`
+//! (eq. 40). For planar motion only `ω_z` is non-zero, so the rotational block enters through
+//! its zz entry, the rotary inertia per length ρI; the in-plane entries are irrelevant and
+//! set equal to it. The integral is the link's Gauss–Legendre rule (see [`quadrature`]).
+//!
+//! [`quadrature`]: crate::quadrature
+
+use nalgebra::DMatrix;
+
+use crate::kinematics::{ArmKinematics, MassPoint};
+use crate::screw::Screw;
+
+/// `D t` for the inertia of a mass point (eq. 40).
+pub(crate) fn inertia_times(p: &MassPoint, t: &Screw) -> Screw {
+    Screw::new(
+        p.inertia * t[0],
+        p.inertia * t[1],
+        p.inertia * t[2],
+        p.mass * t[3],
+        p.mass * t[4],
+        p.mass * t[5],
+    )
+}
+
+impl ArmKinematics<'_> {
+    /// M(q) of eq. 42 (n×n, symmetric positive definite for a well-posed arm).
+    #[must_use]
+    pub fn mass_matrix(&self) -> DMatrix<f64> {
+        let n = self.arm().n();
+        let mut m = DMatrix::zeros(n, n);
+        for p in &self.points {
+            let cols = p.projection.columns();
+            for (a, ca) in cols {
+                let dca = inertia_times(p, ca);
+                for (b, cb) in cols {
+                    m[(*a, *b)] += dca.dot(cb);
+                }
+            }
+        }
+        m
+    }
+
+    /// T = ½ Σ tᵀ D t (eq. 41) at speeds `u`.
+    #[must_use]
+    pub fn kinetic_energy(&self, u: &[f64]) -> f64 {
+        self.points
+            .iter()
+            .map(|p| {
+                let t = p.projection.twist(u);
+                0.5 * t.dot(&inertia_times(p, &t))
+            })
+            .sum()
+    }
+}
