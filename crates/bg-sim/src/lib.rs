@@ -6,5 +6,7 @@ use bg_model::Registry;
 /// Every element kind this build knows: the core kinds plus the domain crates'.
 #[must_use]
 pub fn registry() -> Registry {
-    Registry::with_core()
+    let mut r = Registry::with_core();
+    bg_hydraulics::register(&mut r);
+    r
 }

@@ -1,0 +1,397 @@
+//! Cylinder `hydraulics.cylinder`: a valve-controlled double-acting cylinder as one component
+//! (the paper's Fig. 5, bonds i1–i12), a composite that expands into its members.
+//!
+//! ```text
+//!  valve.A ─⇀ jp (0) ─⇀ chamber_p (C: P_p)          members, named <instance>_<local>:
+//!             jp ─⇀ piston.p                         valve, jp, jr, chamber_p, chamber_r,
+//!             jp ─⇀ leak.a, leak.b ─⇀ jr  (r_int)    piston, rod, [leak, leak_p, leak_r,
+//!             jp ─⇀ leak_p            (r_ext)         end_stop]
+//!  valve.B ─⇀ jr (0) ─⇀ chamber_r (C: P_r)
+//!             jr ─⇀ piston.r,  jr ─⇀ leak_r (r_ext)
+//!  piston.mech ─⇀ rod (1) ─⇀ end_stop     exposed ports: mech = rod, A = jp, B = jr
+//! ```
+//!
+//! The exposed port `mech` carries the net rod force F_c − F_stop (N; positive pushes the pins
+//! apart) as effort and the length rate dl/dt (m/s) as flow; bond it *from* the cylinder to
+//! the mechanism (`"cyl.mech -> load"`). The valve reads the spool stroke `x_v` (a signal
+//! expression). Without a valve (`valve: None`) the lines are driven through the exposed
+//! ports `A` and `B`.
+//!
+//! Chamber pressures start from [`InitialPressures`]; [`hold_pressures`] is the design page's
+//! static initialisation rule.
+
+use bg_model::Composite;
+use bondgraph::{BondGraph, Error, GraphError, OneJunction, Param, ParamError, ZeroJunction};
+
+use crate::{Chamber, EndStop, Leakage, Piston, Side, Valve};
+
+/// The chamber pressures (P_p, P_r) that hold force `force` (N, positive pushing the pins
+/// apart) with the less loaded chamber at `p_pre` (design page, "Initial pressures"):
+/// for F ≥ 0, P_r = p_pre and P_p = (F + A_r·p_pre)/A_p; for F < 0, P_p = p_pre and
+/// P_r = (A_p·p_pre − F)/A_r. Then A_p·P_p − A_r·P_r = F exactly (up to rounding).
+#[must_use]
+pub fn hold_pressures(force: f64, a_p: f64, a_r: f64, p_pre: f64) -> (f64, f64) {
+    if force >= 0.0 {
+        ((force + a_r * p_pre) / a_p, p_pre)
+    } else {
+        (p_pre, (a_p * p_pre - force) / a_r)
+    }
+}
+
+/// How the chamber pressures start.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum InitialPressures {
+    /// Given pressures P_p, P_r (Pa).
+    Given {
+        /// Piston side, Pa.
+        p_p: f64,
+        /// Rod side, Pa.
+        p_r: f64,
+    },
+    /// The pressures that hold `force` (N) with the less loaded chamber at `p_pre` (Pa):
+    /// [`hold_pressures`].
+    Hold {
+        /// Force to hold, N.
+        force: f64,
+        /// Pressure of the less loaded chamber, Pa.
+        p_pre: f64,
+    },
+}
+
+/// The cylinder's directional valve (see [`Valve`]).
+#[derive(Debug)]
+pub struct ValveSpec {
+    /// Orifice coefficient α at full opening, m³/(s·√Pa).
+    pub alpha: f64,
+    /// Spool stroke x_v (dimensionless, clamped to [−1, 1]), usually a signal.
+    pub x_v: Param,
+    /// Supply pressure, Pa.
+    pub p_s: f64,
+    /// Transition pressure of the square-root regularisation, Pa (0: the paper's law).
+    pub p_tr: f64,
+}
+
+/// The cylinder's end stop (see [`EndStop`]), acting past s = 0 and s = s_max.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EndStopSpec {
+    /// Stiffness, N/m.
+    pub k: f64,
+    /// Damping, N·s/m.
+    pub c: f64,
+    /// Contact width over which the damping sets in, m.
+    pub width: f64,
+}
+
+/// A double-acting cylinder with its chambers, piston, leakage, optional valve and end stop.
+/// Lengths in m, areas in m², pressures in Pa.
+#[derive(Debug)]
+pub struct Cylinder {
+    /// Piston area A_p (`a_p`).
+    pub a_p: f64,
+    /// Rod-side (annulus) area A_r (`a_r`).
+    pub a_r: f64,
+    /// Length at s = 0, fully retracted (`l0`); the published length is l = l0 + s.
+    pub l0: f64,
+    /// Piston-side chamber length at s = 0 (`l_p0`): V_p = A_p·(l_p0 + s).
+    pub l_p0: f64,
+    /// Rod-side chamber length at s = 0 (`l_r0`): V_r = A_r·(l_r0 − s).
+    pub l_r0: f64,
+    /// Usable stroke (`s_max`), ≤ `l_r0`.
+    pub s_max: f64,
+    /// Initial stroke (`s0`).
+    pub s0: f64,
+    /// Bulk modulus β (`beta`).
+    pub beta: f64,
+    /// Smallest chamber volume, m³ (`v_min`); default 1e-3 of each chamber's dead volume.
+    pub v_min: Option<f64>,
+    /// Tank pressure P_T (`p_t`).
+    pub p_t: f64,
+    /// Initial chamber pressures.
+    pub initial: InitialPressures,
+    /// The valve, or `None` to drive the lines through ports `A` and `B`.
+    pub valve: Option<ValveSpec>,
+    /// Internal leakage resistance R_l, Pa·s/m³ (`r_int`), if any.
+    pub r_int: Option<f64>,
+    /// External leakage resistance of each chamber to tank, Pa·s/m³ (`r_ext`), if any.
+    pub r_ext: Option<f64>,
+    /// End stop, if any; without one, leaving [0, s_max] stops the run with an error.
+    pub end_stop: Option<EndStopSpec>,
+}
+
+/// Where the exposed ports of a cylinder added with [`Cylinder::add_to`] are: element names.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct CylinderPorts {
+    /// The rod's 1-junction (port `mech`).
+    pub mech: String,
+    /// The piston-side line's 0-junction (port `A`).
+    pub a: String,
+    /// The rod-side line's 0-junction (port `B`).
+    pub b: String,
+    /// The piston (its state `s`, its signal `l`).
+    pub piston: String,
+}
+
+impl Cylinder {
+    /// A cylinder with the given geometry and bulk modulus, at s0 = 0, tank at 0 Pa, both
+    /// chambers at 0 Pa, no valve, no leakage, no end stop. Set the public fields for more.
+    #[must_use]
+    pub fn new(a_p: f64, a_r: f64, l_p0: f64, l_r0: f64, s_max: f64, beta: f64) -> Self {
+        Self {
+            a_p,
+            a_r,
+            l0: 0.0,
+            l_p0,
+            l_r0,
+            s_max,
+            s0: 0.0,
+            beta,
+            v_min: None,
+            p_t: 0.0,
+            initial: InitialPressures::Given { p_p: 0.0, p_r: 0.0 },
+            valve: None,
+            r_int: None,
+            r_ext: None,
+            end_stop: None,
+        }
+    }
+
+    /// The initial pressures (P_p, P_r), Pa.
+    #[must_use]
+    pub fn initial_pressures(&self) -> (f64, f64) {
+        match self.initial {
+            InitialPressures::Given { p_p, p_r } => (p_p, p_r),
+            InitialPressures::Hold { force, p_pre } => {
+                hold_pressures(force, self.a_p, self.a_r, p_pre)
+            }
+        }
+    }
+
+    /// Check the parameters; errors name the model-file keys.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        ParamError::positive("a_p", self.a_p)?;
+        ParamError::positive("a_r", self.a_r)?;
+        ParamError::finite("l0", self.l0)?;
+        ParamError::non_negative("l_p0", self.l_p0)?;
+        ParamError::positive("s_max", self.s_max)?;
+        ParamError::finite("s0", self.s0)?;
+        ParamError::positive("beta", self.beta)?;
+        ParamError::finite("p_t", self.p_t)?;
+        if !(self.l_r0.is_finite() && self.l_r0 >= self.s_max) {
+            return Err(ParamError::Shape {
+                param: "l_r0".into(),
+                message: format!(
+                    "the rod-side chamber length at s = 0 ({} m) must be at least the stroke s_max = {} m",
+                    self.l_r0, self.s_max
+                ),
+            });
+        }
+        if self.end_stop.is_none() && !(0.0..=self.s_max).contains(&self.s0) {
+            return Err(ParamError::Shape {
+                param: "s0".into(),
+                message: format!(
+                    "initial stroke {} m is outside the stroke [0, {}] m",
+                    self.s0, self.s_max
+                ),
+            });
+        }
+        if let Some(v) = self.v_min {
+            ParamError::positive("v_min", v)?;
+        }
+        match self.initial {
+            InitialPressures::Given { p_p, p_r } => {
+                ParamError::finite("p_p0", p_p)?;
+                ParamError::finite("p_r0", p_r)?;
+            }
+            InitialPressures::Hold { force, p_pre } => {
+                ParamError::finite("hold_force", force)?;
+                ParamError::finite("p_pre", p_pre)?;
+            }
+        }
+        if let Some(r) = self.r_int {
+            ParamError::positive("r_int", r)?;
+        }
+        if let Some(r) = self.r_ext {
+            ParamError::positive("r_ext", r)?;
+        }
+        Ok(())
+    }
+
+    /// The members, internal bonds and exposed ports (`mech`, `A`, `B`), for an instance
+    /// called `instance` (signals inside refer to `<instance>_piston.s`).
+    pub fn composite(self, instance: &str) -> Result<Composite, ParamError> {
+        self.validate()?;
+        let stroke_signal = format!("{instance}_piston.s");
+        let stroke = || Param::modulated(vec![stroke_signal.clone()], |_, u| u[0]);
+        let (p_p0, p_r0) = self.initial_pressures();
+        let chamber = |side, area, l, p0| -> Result<Chamber, ParamError> {
+            let c = Chamber::cylinder(side, area, l, self.beta, stroke(), p0)?
+                .with_tank_pressure(self.p_t)?;
+            match self.v_min {
+                Some(v) => c.with_v_min(v),
+                None => Ok(c),
+            }
+        };
+        let mut c = Composite::default();
+        c.element("jp", ZeroJunction)
+            .element("jr", ZeroJunction)
+            .element(
+                "chamber_p",
+                chamber(Side::Piston, self.a_p, self.l_p0, p_p0)?,
+            )
+            .element("chamber_r", chamber(Side::Rod, self.a_r, self.l_r0, p_r0)?)
+            .element(
+                "piston",
+                Piston::new(
+                    self.a_p,
+                    self.a_r,
+                    self.l0,
+                    self.s0,
+                    self.s_max,
+                    self.end_stop.is_none(),
+                )?,
+            )
+            .element("rod", OneJunction);
+        c.bond("b_cp", "jp", "chamber_p")
+            .bond("b_cr", "jr", "chamber_r")
+            .bond("b_pp", "jp", "piston.p")
+            .bond("b_pr", "jr", "piston.r")
+            .bond("b_rod", "piston.mech", "rod");
+        if let Some(v) = self.valve {
+            c.element(
+                "valve",
+                Valve::new(v.alpha, v.x_v, v.p_s, self.p_t, v.p_tr)?,
+            );
+            c.bond("b_va", "valve.A", "jp")
+                .bond("b_vb", "valve.B", "jr");
+        }
+        if let Some(r) = self.r_int {
+            c.element("leak", Leakage::internal(r)?);
+            c.bond("b_la", "jp", "leak.a").bond("b_lb", "leak.b", "jr");
+        }
+        if let Some(r) = self.r_ext {
+            c.element("leak_p", Leakage::to_tank(r, self.p_t)?)
+                .element("leak_r", Leakage::to_tank(r, self.p_t)?);
+            c.bond("b_lp", "jp", "leak_p").bond("b_lr", "jr", "leak_r");
+        }
+        if let Some(e) = self.end_stop {
+            c.element(
+                "end_stop",
+                EndStop::new(stroke(), 0.0, self.s_max, e.k, e.c, e.width)?,
+            );
+            c.bond("b_stop", "rod", "end_stop");
+        }
+        c.port("mech", "rod").port("A", "jp").port("B", "jr");
+        Ok(c)
+    }
+
+    /// Add the cylinder's members to `g` as `<name>_<member>` with their internal bonds;
+    /// returns the elements to bond the exposed ports to.
+    pub fn add_to(self, g: &mut BondGraph, name: &str) -> Result<CylinderPorts, Error> {
+        let c = self.composite(name)?;
+        expand(g, name, c)?;
+        let global = |l: &str| format!("{name}_{l}");
+        Ok(CylinderPorts {
+            mech: global("rod"),
+            a: global("jp"),
+            b: global("jr"),
+            piston: global("piston"),
+        })
+    }
+}
+
+/// Add a composite's members and internal bonds to `g` under `<name>_<local>` names.
+pub fn expand(g: &mut BondGraph, name: &str, c: Composite) -> Result<(), Error> {
+    let global = |l: &str| format!("{name}_{l}");
+    for (local, el) in c.elements {
+        g.add_boxed(&global(&local), el)?;
+    }
+    for (bond, from, to) in &c.bonds {
+        let end = |s: &str| -> Result<(usize, Option<usize>), GraphError> {
+            let (el, port) = s.split_once('.').map_or((s, None), |(e, p)| (e, Some(p)));
+            let id = g
+                .find(&global(el))
+                .ok_or_else(|| GraphError::UnknownElement { name: global(el) })?;
+            let port = port.map(|p| g.port_index(id, p)).transpose()?;
+            Ok((id, port))
+        };
+        let (f, t) = (end(from)?, end(to)?);
+        g.connect_named(&global(bond), f, t)?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+#[allow(clippy::float_cmp)] // exact zeros and copied parameters are meant exactly
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hold_pressures_follow_the_design_rule_and_give_the_force() {
+        let (a_p, a_r) = (0.0452389, 0.0424115);
+        for f in [207e3, -80.6e3, 0.0, 512e3] {
+            let (pp, pr) = hold_pressures(f, a_p, a_r, 1e6);
+            assert!((a_p * pp - a_r * pr - f).abs() <= 1e-9 * f.abs().max(1.0));
+            if f >= 0.0 {
+                assert_eq!(pr, 1e6);
+            } else {
+                assert_eq!(pp, 1e6);
+            }
+        }
+        // the design page's sanity figure: 512 kN with the rod side at tank → P_p ≈ 11.3 MPa
+        let (pp, _) = hold_pressures(512e3, a_p, a_r, 0.0);
+        assert!((pp - 11.32e6).abs() < 0.01e6, "{pp}");
+    }
+
+    #[test]
+    fn validate_names_the_model_keys() {
+        let mut c = Cylinder::new(0.045, 0.042, 0.05, 2.75, 2.7, 1.5e9);
+        assert!(c.validate().is_ok());
+        c.l_r0 = 2.0;
+        let e = c.validate().unwrap_err();
+        assert!(
+            matches!(e, ParamError::Shape { ref param, .. } if param == "l_r0"),
+            "{e}"
+        );
+        c.l_r0 = 2.75;
+        c.s0 = 3.0;
+        assert!(c.validate().is_err());
+        c.end_stop = Some(EndStopSpec {
+            k: 1e9,
+            c: 1e6,
+            width: 1e-3,
+        });
+        assert!(
+            c.validate().is_ok(),
+            "with an end stop the drive may start past the end"
+        );
+    }
+
+    #[test]
+    fn composite_lists_its_members_and_ports() {
+        let mut c = Cylinder::new(0.045, 0.042, 0.05, 2.75, 2.7, 1.5e9);
+        c.r_int = Some(1e13);
+        c.valve = Some(ValveSpec {
+            alpha: 1e-5,
+            x_v: Param::Const(0.0),
+            p_s: 25e6,
+            p_tr: 1e5,
+        });
+        let comp = c.composite("cyl1").unwrap();
+        let names: Vec<&str> = comp.elements.iter().map(|(n, _)| n.as_str()).collect();
+        for m in [
+            "jp",
+            "jr",
+            "chamber_p",
+            "chamber_r",
+            "piston",
+            "rod",
+            "valve",
+            "leak",
+        ] {
+            assert!(names.contains(&m), "{m} missing from {names:?}");
+        }
+        assert!(!names.contains(&"end_stop"));
+        let ports: Vec<&str> = comp.ports.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(ports, ["mech", "A", "B"]);
+    }
+}

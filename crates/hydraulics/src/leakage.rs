@@ -1,0 +1,95 @@
+//! Leakage: laminar `R` elements (paper eq. 82, and the C_in, C_ex terms of eq. 28).
+//!
+//! * `hydraulics.leakage` — internal, between two lines (across the piston): ports `a`, `b`,
+//!   `Q = (P_a − P_b)/R` from `a` to `b`.
+//! * `hydraulics.tank_leakage` — external, from one line to the tank: one port,
+//!   `Q = (P − P_T)/R` out of the line.
+//!
+//! `R` is the leakage resistance in Pa·s/m³ (the paper's R_l = 1/C_in). Dissipates
+//! (ΔP)²/R ≥ 0. Causality: conductance (the lines set the pressures, the leak its flow); the
+//! external leak also accepts resistance causality (P = P_T + R·Q).
+
+use bondgraph::{CausalRule, Element, Io, ParamError, PortCausality, PortSpec, Ports};
+
+/// Laminar leakage with resistance `r` (Pa·s/m³, > 0): internal (two ports) or to a tank at
+/// pressure `p_tank` (one port).
+#[derive(Debug)]
+pub struct Leakage {
+    r: f64,
+    /// `Some(P_T)`: external, one port; `None`: internal, two ports.
+    tank: Option<f64>,
+}
+
+impl Leakage {
+    /// Internal leakage between ports `a` and `b`.
+    pub fn internal(r: f64) -> Result<Self, ParamError> {
+        ParamError::positive("r", r)?;
+        Ok(Self { r, tank: None })
+    }
+
+    /// External leakage from its port to a tank at `p_tank` (Pa).
+    pub fn to_tank(r: f64, p_tank: f64) -> Result<Self, ParamError> {
+        ParamError::positive("r", r)?;
+        ParamError::finite("p_tank", p_tank)?;
+        Ok(Self {
+            r,
+            tank: Some(p_tank),
+        })
+    }
+}
+
+impl Element for Leakage {
+    fn kind(&self) -> &str {
+        match self.tank {
+            None => "hydraulics.leakage",
+            Some(_) => "hydraulics.tank_leakage",
+        }
+    }
+    fn ports(&self) -> Ports {
+        match self.tank {
+            None => Ports::Fixed(vec![PortSpec::new("a", 1), PortSpec::new("b", 1)]),
+            Some(_) => Ports::Fixed(vec![PortSpec::new("1", 1)]),
+        }
+    }
+    fn causal_rule(&self, _: usize) -> CausalRule {
+        use PortCausality::{EffortOut, FlowOut};
+        match self.tank {
+            None => CausalRule::Resistive(vec![vec![FlowOut, FlowOut]]),
+            Some(_) => CausalRule::Resistive(vec![vec![FlowOut], vec![EffortOut]]),
+        }
+    }
+    fn eval(&self, _: usize, io: &mut Io<'_>) {
+        match self.tank {
+            None => {
+                let q = (io.e(0, 0) - io.e(1, 0)) / self.r;
+                io.set_f_in(0, 0, q);
+                io.set_f_in(1, 0, -q);
+            }
+            Some(p_t) => match io.causality(0) {
+                PortCausality::FlowOut => io.set_f_in(0, 0, (io.e(0, 0) - p_t) / self.r),
+                PortCausality::EffortOut => io.set_e(0, 0, p_t + self.r * io.f_in(0, 0)),
+            },
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rejects_non_positive_resistance() {
+        assert!(Leakage::internal(0.0).is_err());
+        assert!(Leakage::internal(f64::INFINITY).is_err());
+        assert!(Leakage::to_tank(-1.0, 0.0).is_err());
+        assert!(Leakage::to_tank(1e12, f64::NAN).is_err());
+        assert_eq!(
+            Leakage::internal(1e13).unwrap().kind(),
+            "hydraulics.leakage"
+        );
+        assert_eq!(
+            Leakage::to_tank(1e13, 0.0).unwrap().kind(),
+            "hydraulics.tank_leakage"
+        );
+    }
+}

@@ -1,0 +1,170 @@
+//! Orifice `hydraulics.orifice`: turbulent flow through a (possibly modulated) opening,
+//! `Q = α·x·regRoot(P_a − P_b)` from port `a` to port `b` (paper eqs. 29–31).
+//!
+//! The square root of the orifice law has an infinite slope at Δp = 0, which a stiff solver
+//! sees as an infinite Jacobian entry. It is regularised as in Modelica.Fluid's `regRoot`:
+//!
+//! ```text
+//! regRoot(Δp) = Δp / (Δp² + p_tr²)^(1/4)
+//! ```
+//!
+//! which equals `sign(Δp)·√|Δp|` up to a relative `¼(p_tr/Δp)²` for |Δp| ≫ p_tr, is linear
+//! with slope `1/√p_tr` near zero, and is C^∞ for p_tr > 0. `p_tr = 0` gives the paper's law
+//! exactly.
+//!
+//! Causality: both ports receive their pressure and set their flow (conductance causality);
+//! attach each to a 0-junction, a chamber or a pressure source. Power `Q·(P_a − P_b)` is
+//! dissipated (≥ 0 for x ≥ 0).
+
+use bondgraph::{
+    CausalRule, Element, Io, Param, ParamError, PortCausality, PortSpec, Ports, SignalSpec, Slot,
+    Stage,
+};
+
+/// The regularised square root `Δp / (Δp² + p_tr²)^(1/4)`; `sign(Δp)·√|Δp|` when `p_tr = 0`.
+#[must_use]
+pub fn reg_root(dp: f64, p_tr: f64) -> f64 {
+    if p_tr == 0.0 {
+        return dp.signum() * dp.abs().sqrt();
+    }
+    dp / (dp * dp + p_tr * p_tr).sqrt().sqrt()
+}
+
+/// Orifice coefficient `α = C_d·w·√(2/ρ)` (eq. 31): discharge coefficient `cd`, opening area
+/// `w` (m²) at full opening, oil density `rho` (kg/m³). Units of α: m³/(s·√Pa).
+pub fn alpha(cd: f64, w: f64, rho: f64) -> Result<f64, ParamError> {
+    ParamError::positive("cd", cd)?;
+    ParamError::positive("w", w)?;
+    ParamError::positive("rho", rho)?;
+    Ok(cd * w * (2.0 / rho).sqrt())
+}
+
+/// Two-port orifice: `Q = α·x·regRoot(P_a − P_b)` flows from `a` to `b`.
+///
+/// * `alpha` — orifice coefficient α, m³/(s·√Pa), > 0 (see [`alpha`]).
+/// * `opening` — relative opening x (dimensionless, may be modulated); not clamped.
+/// * `p_tr` — transition pressure of the regularisation, Pa, ≥ 0.
+#[derive(Debug)]
+pub struct Orifice {
+    alpha: f64,
+    opening: Param,
+    p_tr: f64,
+}
+
+impl Orifice {
+    /// An orifice with coefficient `alpha`, opening `opening` and transition pressure `p_tr`.
+    pub fn new(alpha: f64, opening: impl Into<Param>, p_tr: f64) -> Result<Self, ParamError> {
+        ParamError::positive("alpha", alpha)?;
+        ParamError::non_negative("p_tr", p_tr)?;
+        let opening = opening.into();
+        if let Some(x) = opening.constant() {
+            ParamError::finite("opening", x)?;
+        }
+        Ok(Self {
+            alpha,
+            opening,
+            p_tr,
+        })
+    }
+
+    /// Flow from `a` to `b` at pressures `p_a`, `p_b` and opening `x`.
+    #[must_use]
+    pub fn flow(&self, x: f64, p_a: f64, p_b: f64) -> f64 {
+        self.alpha * x * reg_root(p_a - p_b, self.p_tr)
+    }
+}
+
+impl Element for Orifice {
+    fn kind(&self) -> &str {
+        "hydraulics.orifice"
+    }
+    fn ports(&self) -> Ports {
+        Ports::Fixed(vec![PortSpec::new("a", 1), PortSpec::new("b", 1)])
+    }
+    fn causal_rule(&self, _: usize) -> CausalRule {
+        CausalRule::Resistive(vec![vec![PortCausality::FlowOut, PortCausality::FlowOut]])
+    }
+    fn signal_inputs(&self) -> Vec<SignalSpec> {
+        self.opening.signal_inputs()
+    }
+    fn stages(&self, _: &[PortCausality]) -> Vec<Stage> {
+        let mut reads = vec![Slot::Effort(0), Slot::Effort(1)];
+        reads.extend((0..self.opening.n_inputs()).map(Slot::Input));
+        vec![Stage {
+            writes: vec![Slot::Flow(0), Slot::Flow(1)],
+            reads,
+        }]
+    }
+    fn eval(&self, _: usize, io: &mut Io<'_>) {
+        let q = self.flow(self.opening.value(io, 0), io.e(0, 0), io.e(1, 0));
+        io.set_f_in(0, 0, q);
+        io.set_f_in(1, 0, -q);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn paper(dp: f64) -> f64 {
+        dp.signum() * dp.abs().sqrt()
+    }
+
+    #[test]
+    fn zero_transition_pressure_is_the_paper_law_exactly() {
+        for dp in [-2.5e7, -3.0, -1e-12, 0.0, 1e-12, 7.0, 1e5, 2.5e7] {
+            assert_eq!(reg_root(dp, 0.0).to_bits(), paper(dp).to_bits(), "{dp}");
+        }
+    }
+
+    #[test]
+    fn equals_the_square_root_far_from_zero() {
+        // relative deviation (1 + (p_tr/Δp)²)^(-1/4) − 1 ≈ −¼(p_tr/Δp)² ≤ 2.5e-5 at |Δp| ≥ 100 p_tr
+        let p_tr = 1e5;
+        for dp in [1e7, 2.5e7, -1e7, -3e7, 5e7] {
+            let rel = (reg_root(dp, p_tr) - paper(dp)).abs() / paper(dp).abs();
+            assert!(rel <= 2.5e-5, "Δp = {dp}: relative deviation {rel:e}");
+            let expected = 0.25 * (p_tr / dp).powi(2);
+            assert!(
+                (rel - expected).abs() <= 1e-3 * expected,
+                "{rel:e} vs {expected:e}"
+            );
+        }
+    }
+
+    #[test]
+    fn is_c1_at_zero() {
+        // Slope 1/√p_tr from both sides, by one-sided finite differences (error O(h²/p_tr²)).
+        let p_tr: f64 = 1e5;
+        let slope = 1.0 / p_tr.sqrt();
+        for h in [1.0, 10.0, 100.0] {
+            let right = (reg_root(h, p_tr) - reg_root(0.0, p_tr)) / h;
+            let left = (reg_root(0.0, p_tr) - reg_root(-h, p_tr)) / h;
+            assert!((right - slope).abs() <= 1e-6 * slope, "h = {h}: {right:e}");
+            assert!((left - slope).abs() <= 1e-6 * slope, "h = {h}: {left:e}");
+        }
+        // the derivative is continuous: central differences just left and right of 0 agree
+        let d = |p: f64| (reg_root(p + 1e-3, p_tr) - reg_root(p - 1e-3, p_tr)) / 2e-3;
+        assert!((d(1e-2) - d(-1e-2)).abs() <= 1e-9 * slope);
+        // whereas the paper's law has no finite slope there
+        assert!((paper(1e-6) - paper(0.0)) / 1e-6 > 900.0);
+    }
+
+    #[test]
+    fn alpha_is_eq_31() {
+        let a = alpha(0.6, 0.0007, 880.0).unwrap();
+        assert!((a - 0.6 * 0.0007 * (2.0f64 / 880.0).sqrt()).abs() < 1e-18);
+        assert!(alpha(0.0, 0.0007, 880.0).is_err());
+        assert!(alpha(0.6, 0.0007, -1.0).is_err());
+    }
+
+    #[test]
+    fn rejects_bad_parameters() {
+        assert!(Orifice::new(0.0, 1.0, 1e5).is_err());
+        assert!(Orifice::new(1e-6, 1.0, -1.0).is_err());
+        assert!(Orifice::new(1e-6, f64::NAN, 1e5).is_err());
+        let o = Orifice::new(2e-6, 0.5, 0.0).unwrap();
+        assert!((o.flow(0.5, 4e6, 0.0) - 2e-6 * 0.5 * 2000.0).abs() < 1e-15);
+        assert!((o.flow(0.5, 0.0, 4e6) + 2e-6 * 0.5 * 2000.0).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,191 @@
+//! Piston `hydraulics.piston`: the transformer pair A_p, A_r between the chamber pressures
+//! and the cylinder's force and length rate (paper eqs. 80–81), with the stroke as its state.
+//!
+//! Ports `p` (piston-side line), `r` (rod-side line), `mech` (the rod). With v = ṡ = dl/dt
+//! the extension rate (the flow *out of* `mech`), power in positive:
+//!
+//! ```text
+//! e_mech = F_c = A_p·P_p − A_r·P_r        (positive pushes the pins apart)
+//! f_in,p = A_p·v      f_in,r = −A_r·v     (the piston sweeps A_p·v out of the piston side
+//!                                          and pushes A_r·v into the rod side)
+//! ds/dt  = v
+//! ```
+//!
+//! Power is conserved exactly: P_p·A_p·v − P_r·A_r·v − F_c·v = 0.
+//!
+//! Causality is fixed: the mechanism sets the velocity, the chambers set the pressures
+//! (`p`, `r` receive effort; `mech` sets it). The piston publishes `l = l⁰ + s` (the cylinder
+//! length, m) for controllers, and `past_stroke_end`.
+//!
+//! **Leaving the stroke range.** An element cannot return an error from its evaluation, so a
+//! piston *without* an end stop (`guard = true`) reports a stroke outside `[0, s_max]` the one
+//! way the core stops a run and names the culprit: it sets its signal `past_stroke_end` and
+//! the stroke rate ṡ to NaN. The solver rejects every step that ends past the stroke end, and
+//! the run stops with an error naming `signal <piston>.past_stroke_end = NaN, computed by
+//! <piston> (hydraulics.piston)`. The rows before are kept and are all finite. With an end
+//! stop (`guard = false`) the piston goes on past the ends and the stop pushes it back.
+
+use bondgraph::{
+    CausalRule, Element, Io, ParamError, PortCausality, PortSpec, Ports, SignalSpec, Slot, Stage,
+    StateSpec,
+};
+
+/// Piston with areas `a_p` (piston side) and `a_r` (rod side, annulus), m², and its stroke.
+///
+/// * `l0` — cylinder length at s = 0 (fully retracted), m; only for the published `l`.
+/// * `s0` — initial stroke, m; `s_max` — usable stroke, m, > 0.
+/// * `guard` — stop the run when the stroke leaves `[0, s_max]` (no end stop in the model).
+#[derive(Debug)]
+pub struct Piston {
+    a_p: f64,
+    a_r: f64,
+    l0: f64,
+    s0: f64,
+    s_max: f64,
+    guard: bool,
+}
+
+impl Piston {
+    /// A piston; `0 ≤ s0 ≤ s_max` is required when `guard` is on.
+    pub fn new(
+        a_p: f64,
+        a_r: f64,
+        l0: f64,
+        s0: f64,
+        s_max: f64,
+        guard: bool,
+    ) -> Result<Self, ParamError> {
+        ParamError::positive("a_p", a_p)?;
+        ParamError::positive("a_r", a_r)?;
+        ParamError::finite("l0", l0)?;
+        ParamError::finite("s0", s0)?;
+        ParamError::positive("s_max", s_max)?;
+        if guard && !(0.0..=s_max).contains(&s0) {
+            return Err(ParamError::Shape {
+                param: "s0".into(),
+                message: format!("initial stroke {s0} m is outside the stroke [0, {s_max}] m"),
+            });
+        }
+        Ok(Self {
+            a_p,
+            a_r,
+            l0,
+            s0,
+            s_max,
+            guard,
+        })
+    }
+
+    /// Cylinder force `F_c = A_p·P_p − A_r·P_r` (N).
+    #[must_use]
+    pub fn force(&self, p_p: f64, p_r: f64) -> f64 {
+        self.a_p * p_p - self.a_r * p_r
+    }
+
+    /// Whether stroke `s` is outside the guarded range (always false without the guard).
+    #[must_use]
+    pub fn past_end(&self, s: f64) -> bool {
+        self.guard && !(0.0..=self.s_max).contains(&s)
+    }
+
+    fn v(io: &Io<'_>) -> f64 {
+        -io.f_in(2, 0)
+    }
+}
+
+impl Element for Piston {
+    fn kind(&self) -> &str {
+        "hydraulics.piston"
+    }
+    fn ports(&self) -> Ports {
+        Ports::Fixed(vec![
+            PortSpec::new("p", 1),
+            PortSpec::new("r", 1),
+            PortSpec::new("mech", 1),
+        ])
+    }
+    fn causal_rule(&self, _: usize) -> CausalRule {
+        use PortCausality::{EffortOut, FlowOut};
+        CausalRule::Fixed(vec![FlowOut, FlowOut, EffortOut])
+    }
+    fn states(&self) -> Vec<StateSpec> {
+        vec![StateSpec::new("s", self.s0).nominal(self.s_max)]
+    }
+    fn signal_outputs(&self) -> Vec<SignalSpec> {
+        vec![
+            SignalSpec::scalar("l"),
+            SignalSpec::scalar("past_stroke_end"),
+        ]
+    }
+    fn stages(&self, _: &[PortCausality]) -> Vec<Stage> {
+        vec![
+            Stage {
+                writes: vec![Slot::Output(0), Slot::Output(1)],
+                reads: Vec::new(),
+            },
+            Stage {
+                writes: vec![Slot::Effort(2)],
+                reads: vec![Slot::Effort(0), Slot::Effort(1)],
+            },
+            Stage {
+                writes: vec![Slot::Flow(0), Slot::Flow(1)],
+                reads: vec![Slot::Flow(2)],
+            },
+        ]
+    }
+    fn eval(&self, stage: usize, io: &mut Io<'_>) {
+        match stage {
+            0 => {
+                let s = io.states()[0];
+                io.set_y(0, 0, self.l0 + s);
+                io.set_y(1, 0, if self.past_end(s) { f64::NAN } else { 0.0 });
+            }
+            1 => {
+                let f = self.force(io.e(0, 0), io.e(1, 0));
+                io.set_e(2, 0, f);
+            }
+            _ => {
+                let v = Self::v(io);
+                io.set_f_in(0, 0, self.a_p * v);
+                io.set_f_in(1, 0, -self.a_r * v);
+            }
+        }
+    }
+    fn derivatives(&self, io: &Io<'_>, dx: &mut [f64]) {
+        dx[0] = if self.past_end(io.states()[0]) {
+            f64::NAN
+        } else {
+            Self::v(io)
+        };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn force_is_a_p_p_p_minus_a_r_p_r() {
+        let p = Piston::new(0.0452389, 0.0424115, 3.5, 0.1, 2.7, true).unwrap();
+        let f = p.force(11.3e6, 1e6);
+        assert!((f - (0.0452389 * 11.3e6 - 0.0424115 * 1e6)).abs() < 1e-6);
+    }
+
+    #[test]
+    fn guard_covers_exactly_the_stroke() {
+        let p = Piston::new(0.04, 0.03, 3.5, 0.0, 2.7, true).unwrap();
+        assert!(!p.past_end(0.0) && !p.past_end(2.7) && !p.past_end(1.0));
+        assert!(p.past_end(-1e-12) && p.past_end(2.7 + 1e-12));
+        let q = Piston::new(0.04, 0.03, 3.5, 0.0, 2.7, false).unwrap();
+        assert!(!q.past_end(-1.0) && !q.past_end(5.0));
+    }
+
+    #[test]
+    fn rejects_bad_parameters() {
+        assert!(Piston::new(0.0, 0.03, 3.5, 0.0, 2.7, true).is_err());
+        assert!(Piston::new(0.04, -0.03, 3.5, 0.0, 2.7, true).is_err());
+        assert!(Piston::new(0.04, 0.03, 3.5, 0.0, 0.0, true).is_err());
+        assert!(Piston::new(0.04, 0.03, 3.5, 3.0, 2.7, true).is_err());
+        assert!(Piston::new(0.04, 0.03, 3.5, 3.0, 2.7, false).is_ok());
+    }
+}

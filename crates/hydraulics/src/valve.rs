@@ -1,0 +1,204 @@
+//! Directional control valve `hydraulics.valve` (4/3, proportional, closed centre): the two
+//! modulated flow sources of the paper's eqs. 29–30, one per cylinder line.
+//!
+//! With spool stroke x_v ∈ [−1, 1] (clamped), supply pressure P_s, tank pressure P_T and the
+//! line pressures P_A (piston side), P_B (rod side), the flows *delivered into* the lines are
+//!
+//! ```text
+//! x_v ≥ 0:  Q_A =  α·x_v·regRoot(P_s − P_A)    Q_B = −α·x_v·regRoot(P_B − P_T)
+//! x_v < 0:  Q_A =  α·x_v·regRoot(P_A − P_T)    Q_B = −α·x_v·regRoot(P_s − P_B)
+//! ```
+//!
+//! (x_v ≥ 0 connects A to supply and B to tank; x_v < 0 the reverse.) With `p_tr = 0`,
+//! `regRoot` is `sign·√|·|` and these are eqs. 29–30 verbatim; see [`crate::orifice`]. Both
+//! branches give zero flow at x_v = 0, so the law is continuous in x_v.
+//!
+//! Causality: ports `A` and `B` receive the line pressures and set the flows (the paper's
+//! modulated `Sf`s, which read the chamber pressures). Draw the bonds from the valve to the
+//! lines: the bond flow is then Q_A (Q_B).
+
+use bondgraph::{
+    CausalRule, Element, Io, Param, ParamError, PortCausality, PortSpec, Ports, SignalSpec, Slot,
+    Stage,
+};
+
+use crate::orifice::reg_root;
+
+/// 4/3 proportional directional valve.
+///
+/// * `alpha` — orifice coefficient α at full opening, m³/(s·√Pa), > 0 (eq. 31).
+/// * `x_v` — spool stroke, dimensionless, may be modulated; clamped to [−1, 1].
+/// * `p_s`, `p_t` — supply and tank pressure, Pa (gauge), `p_s > p_t`.
+/// * `p_tr` — transition pressure of the square-root regularisation, Pa, ≥ 0.
+#[derive(Debug)]
+pub struct Valve {
+    alpha: f64,
+    x_v: Param,
+    p_s: f64,
+    p_t: f64,
+    p_tr: f64,
+}
+
+impl Valve {
+    /// A valve; see the struct documentation for the parameters.
+    pub fn new(
+        alpha: f64,
+        x_v: impl Into<Param>,
+        p_s: f64,
+        p_t: f64,
+        p_tr: f64,
+    ) -> Result<Self, ParamError> {
+        ParamError::positive("alpha", alpha)?;
+        ParamError::finite("p_s", p_s)?;
+        ParamError::finite("p_t", p_t)?;
+        ParamError::non_negative("p_tr", p_tr)?;
+        if p_s <= p_t {
+            return Err(ParamError::Shape {
+                param: "p_s".into(),
+                message: format!("supply pressure {p_s} Pa must exceed tank pressure {p_t} Pa"),
+            });
+        }
+        let x_v = x_v.into();
+        if let Some(x) = x_v.constant() {
+            ParamError::finite("x_v", x)?;
+        }
+        Ok(Self {
+            alpha,
+            x_v,
+            p_s,
+            p_t,
+            p_tr,
+        })
+    }
+
+    /// Flows `(Q_A, Q_B)` delivered into lines A and B at spool stroke `x_v` (clamped to
+    /// [−1, 1]) and line pressures `p_a`, `p_b`.
+    #[must_use]
+    pub fn flows(&self, x_v: f64, p_a: f64, p_b: f64) -> (f64, f64) {
+        let x = x_v.clamp(-1.0, 1.0);
+        let r = |dp: f64| self.alpha * x * reg_root(dp, self.p_tr);
+        if x >= 0.0 {
+            (r(self.p_s - p_a), -r(p_b - self.p_t))
+        } else {
+            (r(p_a - self.p_t), -r(self.p_s - p_b))
+        }
+    }
+}
+
+impl Element for Valve {
+    fn kind(&self) -> &str {
+        "hydraulics.valve"
+    }
+    fn ports(&self) -> Ports {
+        Ports::Fixed(vec![PortSpec::new("A", 1), PortSpec::new("B", 1)])
+    }
+    fn causal_rule(&self, _: usize) -> CausalRule {
+        CausalRule::Fixed(vec![PortCausality::FlowOut, PortCausality::FlowOut])
+    }
+    fn signal_inputs(&self) -> Vec<SignalSpec> {
+        self.x_v.signal_inputs()
+    }
+    fn stages(&self, _: &[PortCausality]) -> Vec<Stage> {
+        // Line A's flow needs only line A's pressure (and the spool), likewise B.
+        let spool: Vec<Slot> = (0..self.x_v.n_inputs()).map(Slot::Input).collect();
+        (0..2)
+            .map(|p| {
+                let mut reads = vec![Slot::Effort(p)];
+                reads.extend(spool.iter().copied());
+                Stage {
+                    writes: vec![Slot::Flow(p)],
+                    reads,
+                }
+            })
+            .collect()
+    }
+    fn eval(&self, stage: usize, io: &mut Io<'_>) {
+        let x = self.x_v.value(io, 0);
+        let (q_a, q_b) = self.flows(x, io.e(0, 0), io.e(1, 0));
+        // delivered into the line: the flow into the valve is its negative
+        if stage == 0 {
+            io.set_f_in(0, 0, -q_a);
+        } else {
+            io.set_f_in(1, 0, -q_b);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Eqs. 29–30 written out as printed, with P_r the tank pressure.
+    fn paper(alpha: f64, x: f64, p_s: f64, p_t: f64, pp: f64, pr: f64) -> (f64, f64) {
+        let sq = |d: f64| d.signum() * d.abs().sqrt();
+        if x >= 0.0 {
+            (alpha * sq(p_s - pp) * x, -alpha * sq(pr - p_t) * x)
+        } else {
+            (alpha * sq(pp - p_t) * x, -alpha * sq(p_s - pr) * x)
+        }
+    }
+
+    #[test]
+    fn zero_transition_pressure_reproduces_eqs_29_30() {
+        let a = crate::orifice::alpha(0.6, 0.0007, 880.0).unwrap();
+        let v = Valve::new(a, 0.0, 25e6, 0.0, 0.0).unwrap();
+        for x in [-1.0, -0.3, 0.0, 0.2, 1.0] {
+            for (pa, pb) in [(11e6, 1e6), (26e6, -0.5e6), (0.0, 25e6), (3e5, 3e5)] {
+                let (qa, qb) = v.flows(x, pa, pb);
+                let (ea, eb) = paper(a, x, 25e6, 0.0, pa, pb);
+                assert!(
+                    (qa - ea).abs() <= 1e-14 * ea.abs().max(1e-9),
+                    "{x} {pa}: {qa} {ea}"
+                );
+                assert!(
+                    (qb - eb).abs() <= 1e-14 * eb.abs().max(1e-9),
+                    "{x} {pb}: {qb} {eb}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn regularised_law_is_within_2p5e_5_of_eqs_29_30_far_from_zero() {
+        let a = 1e-6;
+        let v = Valve::new(a, 0.0, 25e6, 0.0, 1e5).unwrap();
+        for x in [-1.0, -0.5, 0.5, 1.0] {
+            // every orifice pressure drop is ≥ 1e7 = 100·p_tr here
+            let (qa, qb) = v.flows(x, 12e6, 12e6 - 2e6 * x.signum());
+            let (ea, eb) = paper(a, x, 25e6, 0.0, 12e6, 12e6 - 2e6 * x.signum());
+            assert!((qa - ea).abs() <= 2.5e-5 * ea.abs(), "{qa} {ea}");
+            assert!((qb - eb).abs() <= 2.5e-5 * eb.abs(), "{qb} {eb}");
+        }
+    }
+
+    #[test]
+    fn flows_are_c1_in_the_line_pressure_at_zero_drop() {
+        // x_v > 0: line B drains to tank; at P_B = P_T the slope is α·x/√p_tr from both sides.
+        let (a, x, p_tr): (f64, f64, f64) = (1e-6, 0.4, 1e5);
+        let v = Valve::new(a, 0.0, 25e6, 0.0, p_tr).unwrap();
+        let slope = -a * x / p_tr.sqrt();
+        let qb = |p: f64| v.flows(x, 10e6, p).1;
+        for h in [1.0, 10.0] {
+            let right = (qb(h) - qb(0.0)) / h;
+            let left = (qb(0.0) - qb(-h)) / h;
+            assert!(
+                (right - slope).abs() <= 1e-6 * slope.abs(),
+                "{right:e} vs {slope:e}"
+            );
+            assert!(
+                (left - slope).abs() <= 1e-6 * slope.abs(),
+                "{left:e} vs {slope:e}"
+            );
+        }
+    }
+
+    #[test]
+    fn spool_is_clamped_and_parameters_checked() {
+        let v = Valve::new(1e-6, 0.0, 25e6, 0.0, 1e5).unwrap();
+        assert_eq!(v.flows(3.0, 1e6, 1e6), v.flows(1.0, 1e6, 1e6));
+        assert!(Valve::new(1e-6, 0.0, 1e6, 2e6, 1e5).is_err());
+        assert!(Valve::new(-1e-6, 0.0, 25e6, 0.0, 1e5).is_err());
+        assert!(Valve::new(1e-6, 0.0, 25e6, 0.0, -1.0).is_err());
+        assert!(Valve::new(1e-6, f64::INFINITY, 25e6, 0.0, 1e5).is_err());
+    }
+}
