@@ -40,6 +40,7 @@
 
 pub mod actuator;
 pub mod arm;
+pub mod elements;
 pub mod error;
 pub mod gravity;
 pub mod joint;
@@ -53,11 +54,17 @@ pub mod pin;
 pub mod projection;
 pub mod quadrature;
 pub mod reactions;
+pub mod register;
+pub mod scene;
 pub mod screw;
 pub mod stiffness;
 
 pub use actuator::LinearActuator;
 pub use arm::{PlanarArm, Pose, Station};
+pub use elements::{
+    ActuatorTransformer, ArmCompliance, ArmDamping, ArmInertia, ArmReactions, LumpedGravity,
+    LumpedMassTransformer, LumpedMasses,
+};
 pub use error::ManipulatorError;
 pub use joint::RevoluteJoint;
 pub use kinematics::ArmKinematics;
@@ -68,4 +75,6 @@ pub use pin::Pin;
 pub use projection::Projection;
 pub use quadrature::GaussLegendre;
 pub use reactions::PointLoad;
+pub use register::register;
+pub use scene::{ArmScene, LumpedMassModel, SceneError};
 pub use screw::{CoordinateTransform, ReferenceTransform, ScrewTransform};

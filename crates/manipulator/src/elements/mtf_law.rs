@@ -1,0 +1,39 @@
+//! The matrix-MTF law shared by the actuator and lumped-mass transformers, in the core's
+//! convention (`bondgraph::MatrixTransformer`): `e₁ = T e₂`, `f_in₂ = −Tᵀ f_in₁`. Power is
+//! conserved for every T: `e₁ᵀf_in₁ + e₂ᵀf_in₂ = e₂ᵀTᵀf_in₁ − e₂ᵀTᵀf_in₁ = 0`.
+
+use bondgraph::{Io, Slot, Stage};
+use nalgebra::DMatrix;
+
+/// Stage 0 writes e₁ from e₂, stage 1 writes f₂ (and `flow_outputs`) from f₁; both read
+/// the modulating signal input 0.
+pub(crate) fn stages(flow_outputs: &[usize]) -> Vec<Stage> {
+    let mut flow_writes = vec![Slot::Flow(1)];
+    flow_writes.extend(flow_outputs.iter().map(|&o| Slot::Output(o)));
+    vec![
+        Stage {
+            writes: vec![Slot::Effort(0)],
+            reads: vec![Slot::Effort(1), Slot::Input(0)],
+        },
+        Stage {
+            writes: flow_writes,
+            reads: vec![Slot::Flow(0), Slot::Input(0)],
+        },
+    ]
+}
+
+/// `e₁ = T e₂`.
+pub(crate) fn set_effort(io: &mut Io<'_>, t: &DMatrix<f64>) {
+    for i in 0..t.nrows() {
+        let e: f64 = (0..t.ncols()).map(|j| t[(i, j)] * io.e(1, j)).sum();
+        io.set_e(0, i, e);
+    }
+}
+
+/// `f_in₂ = −Tᵀ f_in₁`.
+pub(crate) fn set_flow(io: &mut Io<'_>, t: &DMatrix<f64>) {
+    for j in 0..t.ncols() {
+        let f: f64 = (0..t.nrows()).map(|i| t[(i, j)] * io.f_in(0, i)).sum();
+        io.set_f_in(1, j, -f);
+    }
+}
