@@ -15,7 +15,7 @@ use crate::arm::{PlanarArm, Pose};
 use crate::error::ManipulatorError;
 use crate::pin::Pin;
 use crate::projection::Projection;
-use crate::screw::{interchange, wrench, CoordinateTransform};
+use crate::screw::{swap, wrench};
 
 /// A linear actuator (hydraulic cylinder) between pins `a` and `b`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -70,9 +70,10 @@ impl PlanarArm {
                 return tau;
             };
             let p = Projection::at(pose, &s);
-            let wi = CoordinateTransform::planar(-pose.chord_angle(link))
+            let wi = pose
+                .screw_to_frame(link)
                 .apply(&wrench(Vector3::new(f.x, f.y, 0.0), Vector3::zeros()));
-            p.add_transpose_times(&(interchange() * wi), tau.as_mut_slice());
+            p.add_transpose_times(&swap(&wi), tau.as_mut_slice());
         }
         tau
     }

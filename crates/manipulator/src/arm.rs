@@ -11,13 +11,17 @@
 //! frame 0 for i = 1, at the end of link i−1's chord otherwise; its x axis runs along link
 //! i's chord at the angle `φ_i = q_1 + … + q_i` from x₀.
 
+use std::cell::RefCell;
+
 use nalgebra::Vector2;
 
 use crate::error::ManipulatorError;
 use crate::joint::RevoluteJoint;
+use crate::kinematics::ProjectionCache;
 use crate::link::Link;
 use crate::pin::Pin;
 use crate::quadrature::GaussLegendre;
+use crate::screw::{rot_z_cs, CoordinateTransform};
 
 /// A point on a link's axis at distance `x` along its chord, with the mode shapes evaluated
 /// there (`ψ_k(x)`, `θ_k(x)`).
@@ -50,6 +54,7 @@ pub struct PlanarArm {
     modal_offset: Vec<usize>,
     n: usize,
     mass_stations: Vec<MassStation>,
+    cache: RefCell<ProjectionCache>,
 }
 
 impl PlanarArm {
@@ -84,6 +89,7 @@ impl PlanarArm {
             modal_offset,
             n,
             mass_stations: Vec::new(),
+            cache: RefCell::new(None),
         };
         arm.mass_stations = arm.build_mass_stations();
         Ok(arm)
@@ -155,6 +161,9 @@ impl PlanarArm {
     pub(crate) fn mass_stations(&self) -> &[MassStation] {
         &self.mass_stations
     }
+    pub(crate) fn projection_cache(&self) -> &RefCell<ProjectionCache> {
+        &self.cache
+    }
 
     /// A line of names for q: `q1.., qb1_1..` (1-based, as in the design page).
     #[must_use]
@@ -211,19 +220,23 @@ impl PlanarArm {
         assert_eq!(q.len(), self.n, "q has {} entries, the arm {}", q.len(), self.n);
         let nl = self.links.len();
         let mut phi = Vec::with_capacity(nl);
+        let mut cs = Vec::with_capacity(nl);
         let mut origin = Vec::with_capacity(nl + 1);
         let (mut a, mut o) = (0.0, Vector2::zeros());
         for (i, link) in self.links.iter().enumerate() {
             a += q[i];
+            let (s, c) = a.sin_cos();
             phi.push(a);
+            cs.push((c, s));
             origin.push(o);
-            o += link.length() * Vector2::new(a.cos(), a.sin());
+            o += link.length() * Vector2::new(c, s);
         }
         origin.push(o);
         Pose {
             arm: self,
             q,
             phi,
+            cs,
             origin,
         }
     }
@@ -235,6 +248,8 @@ pub struct Pose<'a> {
     arm: &'a PlanarArm,
     q: &'a [f64],
     phi: Vec<f64>,
+    /// (cos φ_i, sin φ_i)
+    cs: Vec<(f64, f64)>,
     origin: Vec<Vector2<f64>>,
 }
 
@@ -253,6 +268,36 @@ impl<'a> Pose<'a> {
     #[must_use]
     pub fn chord_angle(&self, i: usize) -> f64 {
         self.phi[i]
+    }
+    /// `R_i^0 v`: a vector in the coordinates of frame i expressed in frame 0.
+    #[must_use]
+    pub fn to_base(&self, i: usize, v: &Vector2<f64>) -> Vector2<f64> {
+        let (c, s) = self.cs[i];
+        Vector2::new(c * v.x - s * v.y, s * v.x + c * v.y)
+    }
+    /// `R_0^i v`: a vector in frame 0 expressed in the coordinates of frame i.
+    #[must_use]
+    pub fn to_frame(&self, i: usize, v: &Vector2<f64>) -> Vector2<f64> {
+        let (c, s) = self.cs[i];
+        Vector2::new(c * v.x + s * v.y, -s * v.x + c * v.y)
+    }
+    /// `R̄_0^i` (eq. 11): screws from frame 0 into the coordinates of frame i.
+    #[must_use]
+    pub fn screw_to_frame(&self, i: usize) -> CoordinateTransform {
+        let (c, s) = self.cs[i];
+        CoordinateTransform::new(rot_z_cs(c, -s))
+    }
+    /// `R̄_i^0` (eq. 11): screws from the coordinates of frame i into frame 0.
+    #[must_use]
+    pub fn screw_to_base(&self, i: usize) -> CoordinateTransform {
+        let (c, s) = self.cs[i];
+        CoordinateTransform::new(rot_z_cs(c, s))
+    }
+    /// `(cos, sin)` of the rotation `R_j^i` from frame j to frame i (angle φ_j − φ_i).
+    #[must_use]
+    pub fn relative_rotation(&self, j: usize, i: usize) -> (f64, f64) {
+        let ((cj, sj), (ci, si)) = (self.cs[j], self.cs[i]);
+        (cj * ci + sj * si, sj * ci - cj * si)
     }
     /// Position of joint i (origin of frame i) in frame 0; `origin(n_links)` is the end of
     /// the last chord.
@@ -284,7 +329,7 @@ impl<'a> Pose<'a> {
     /// Position of a station in frame 0.
     #[must_use]
     pub fn position(&self, s: &Station) -> Vector2<f64> {
-        self.origin[s.link] + rotate(self.phi[s.link], &self.local(s))
+        self.origin[s.link] + self.to_base(s.link, &self.local(s))
     }
     /// Position of a pin in frame 0 (a pin on a link sits on its deformed axis).
     ///
@@ -297,13 +342,6 @@ impl<'a> Pose<'a> {
             Pin::Link { link, x } => self.position(&self.arm.station_unchecked(link, x)),
         }
     }
-}
-
-/// Rotate a planar vector by `angle`.
-#[must_use]
-pub(crate) fn rotate(angle: f64, v: &Vector2<f64>) -> Vector2<f64> {
-    let (s, c) = angle.sin_cos();
-    Vector2::new(c * v.x - s * v.y, s * v.x + c * v.y)
 }
 
 /// `ẑ × v` for a planar vector.

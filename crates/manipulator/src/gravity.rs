@@ -2,26 +2,24 @@
 //!
 //! Each mass point carries the gravity wrench `w^{0(g)} = [0 −m g 0 0 0 0]ᵀ` (eq. 48, for a
 //! quadrature point `m = w ρA`) at its deformed position, re-expressed in its link's frame,
-//! `w^{i(g)} = R̄_0^i w^{0(g)}` (eq. 47), and projected: `G = Σ Pᵀ Π w^{i(g)}` (eq. 45). Then
+//! `w^{i(g)} = R̄_0^i w^{0(g)}` (eq. 47), and projected: `G = Σ Pᵀ Π w^{i(g)}` (eq. 45, `Π` applied as [`swap`]). Then
 //! `G = −∂V_g/∂q` with `V_g = Σ m g y`.
 
 use nalgebra::{DVector, Vector3};
 
 use crate::kinematics::ArmKinematics;
-use crate::screw::{interchange, wrench, CoordinateTransform};
+use crate::screw::{swap, wrench};
 
 impl ArmKinematics<'_> {
     /// G(q) of eq. 45.
     #[must_use]
     pub fn gravity_forces(&self) -> DVector<f64> {
         let arm = self.arm();
-        let pi = interchange();
         let mut g = DVector::zeros(arm.n());
-        for p in &self.points {
+        for p in self.points() {
             let w0 = wrench(Vector3::new(0.0, -p.mass * arm.gravity(), 0.0), Vector3::zeros());
-            let phi = self.pose.chord_angle(p.projection.link());
-            let wi = CoordinateTransform::planar(-phi).apply(&w0);
-            p.projection.add_transpose_times(&(pi * wi), g.as_mut_slice());
+            let wi = self.pose.screw_to_frame(p.projection.link()).apply(&w0);
+            p.projection.add_transpose_times(&swap(&wi), g.as_mut_slice());
         }
         g
     }
@@ -30,9 +28,8 @@ impl ArmKinematics<'_> {
     #[must_use]
     pub fn gravity_potential(&self) -> f64 {
         let g = self.arm().gravity();
-        self.points
-            .iter()
-            .map(|p| p.mass * g * self.pose.position(&p.station).y)
+        self.points()
+            .map(|p| p.mass * g * self.pose.position(p.station).y)
             .sum()
     }
 }

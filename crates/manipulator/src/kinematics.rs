@@ -1,26 +1,36 @@
 //! [`ArmKinematics`]: the projection matrix of every mass-carrying station at one
-//! configuration, computed once and shared by M (eq. 42), E (eq. 44) and G (eq. 45).
+//! configuration, computed once and shared by M (eq. 42), E (eq. 44), G (eq. 45) and the
+//! reaction forces.
+//!
+//! The I-, C-field and reaction block of one arm all evaluate at the same q in one
+//! right-hand-side evaluation, so the arm keeps the projections of the configuration it was
+//! last asked for and hands them out again for the same q (compared bit for bit).
+
+use std::sync::Arc;
 
 use crate::arm::{PlanarArm, Pose, Station};
 use crate::projection::Projection;
 
 /// One mass-carrying station at a configuration: its projection and its inertia.
-#[derive(Clone, Debug)]
-pub(crate) struct MassPoint {
-    pub(crate) projection: Projection,
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct MassPoint<'a> {
+    pub(crate) projection: &'a Projection,
     /// Mass (kg): `w·ρA` for a quadrature point, `m` for a point mass.
     pub(crate) mass: f64,
     /// Rotary inertia about z (kg·m²): `w·ρI`, or a point mass's own.
     pub(crate) inertia: f64,
     /// The station (link, x, mode values).
-    pub(crate) station: Station,
+    pub(crate) station: &'a Station,
 }
+
+/// The projections of the last configuration an arm was asked for.
+pub(crate) type ProjectionCache = Option<(Vec<f64>, Arc<Vec<Projection>>)>;
 
 /// The arm at configuration q with the projection matrix of each of its mass stations.
 #[derive(Clone, Debug)]
 pub struct ArmKinematics<'a> {
     pub(crate) pose: Pose<'a>,
-    pub(crate) points: Vec<MassPoint>,
+    projections: Arc<Vec<Projection>>,
 }
 
 impl PlanarArm {
@@ -31,17 +41,21 @@ impl PlanarArm {
     #[must_use]
     pub fn kinematics<'a>(&'a self, q: &'a [f64]) -> ArmKinematics<'a> {
         let pose = self.pose(q);
-        let points = self
-            .mass_stations()
-            .iter()
-            .map(|ms| MassPoint {
-                projection: Projection::at(&pose, &ms.station),
-                mass: ms.mass,
-                inertia: ms.inertia,
-                station: ms.station.clone(),
-            })
-            .collect();
-        ArmKinematics { pose, points }
+        let mut cache = self.projection_cache().borrow_mut();
+        let projections = match cache.as_ref() {
+            Some((key, p)) if key.as_slice() == q => p.clone(),
+            _ => {
+                let p: Arc<Vec<Projection>> = Arc::new(
+                    self.mass_stations()
+                        .iter()
+                        .map(|ms| Projection::at(&pose, &ms.station))
+                        .collect(),
+                );
+                *cache = Some((q.to_vec(), p.clone()));
+                p
+            }
+        };
+        ArmKinematics { pose, projections }
     }
 }
 
@@ -55,5 +69,18 @@ impl<'a> ArmKinematics<'a> {
     #[must_use]
     pub fn arm(&self) -> &'a PlanarArm {
         self.pose.arm()
+    }
+    /// Every mass-carrying station with its projection.
+    pub(crate) fn points(&self) -> impl Iterator<Item = MassPoint<'_>> {
+        self.arm()
+            .mass_stations()
+            .iter()
+            .zip(self.projections.iter())
+            .map(|(ms, projection)| MassPoint {
+                projection,
+                mass: ms.mass,
+                inertia: ms.inertia,
+                station: &ms.station,
+            })
     }
 }

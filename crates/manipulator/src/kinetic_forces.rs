@@ -42,8 +42,15 @@ pub(crate) struct PointVelocity {
     pub(crate) a_v: Vector2<f64>,
 }
 
-impl MassPoint {
-    pub(crate) fn velocity(&self, u: &[f64], modal_offset: usize) -> PointVelocity {
+impl MassPoint<'_> {
+    /// Velocity terms at speeds u; `on_partial(k, ∂v/∂q_k, v)` is called for every coordinate
+    /// k the velocity depends on (joints 1..=i of the chain, then the link's modes).
+    pub(crate) fn velocity_with(
+        &self,
+        u: &[f64],
+        modal_offset: usize,
+        mut on_partial: impl FnMut(usize, Vector2<f64>, &Vector2<f64>),
+    ) -> PointVelocity {
         let t = self.projection.twist(u);
         let v = Vector2::new(t[3], t[4]);
         let d = self.projection.arms();
@@ -51,19 +58,23 @@ impl MassPoint {
         let phi_dot: f64 = u[..=i].iter().sum();
         let mut a_v = Vector2::zeros();
         for k in 1..=i {
-            let dv = self.dv_rigid(u, k);
+            let mut dv = Vector2::zeros();
+            for j in 0..k {
+                dv -= u[j] * (d[k] - d[j]);
+            }
             a_v += u[k] * dv;
+            on_partial(k, dv, &v);
         }
         for (k, psi) in self.station.psi.iter().enumerate() {
-            a_v += u[modal_offset + k] * (-phi_dot * psi) * Vector2::x();
+            let dv = Vector2::new(-phi_dot * psi, 0.0);
+            a_v += u[modal_offset + k] * dv;
+            on_partial(modal_offset + k, dv, &v);
         }
         PointVelocity { v, phi_dot, a_v }
     }
 
-    /// ∂v/∂q_k for joint k (0-based) of the point's link chain.
-    fn dv_rigid(&self, u: &[f64], k: usize) -> Vector2<f64> {
-        let d = self.projection.arms();
-        (0..k).fold(Vector2::zeros(), |acc, j| acc - u[j] * (d[k] - d[j]))
+    pub(crate) fn velocity(&self, u: &[f64], modal_offset: usize) -> PointVelocity {
+        self.velocity_with(u, modal_offset, |_, _, _| ())
     }
 }
 
@@ -81,19 +92,12 @@ impl ArmKinematics<'_> {
         let n = arm.n();
         let mut e = DVector::zeros(n);
         let mut mdot_u = DVector::zeros(n);
-        for p in &self.points {
+        for p in self.points() {
             let i = p.projection.link();
             let o = arm.modal_offset(i);
-            let pv = p.velocity(u, o);
-            let d = p.projection.arms();
-            // E
-            for k in 1..=i {
-                e[k] += p.mass * pv.v.dot(&p.dv_rigid(u, k));
-            }
-            for (k, psi) in p.station.psi.iter().enumerate() {
-                e[o + k] += -p.mass * pv.phi_dot * psi * pv.v.x;
-            }
+            let pv = p.velocity_with(u, o, |k, dv, v| e[k] += p.mass * v.dot(&dv));
             // Ṗᵀ D t
+            let d = p.projection.arms();
             let w_dot: f64 = p.station.psi.iter().enumerate().map(|(k, s)| s * u[o + k]).sum();
             for j in 0..=i {
                 let mut d_dot = Vector2::new(0.0, w_dot);

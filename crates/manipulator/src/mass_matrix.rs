@@ -13,7 +13,7 @@ use crate::kinematics::{ArmKinematics, MassPoint};
 use crate::screw::Screw;
 
 /// `D t` for the inertia of a mass point (eq. 40).
-pub(crate) fn inertia_times(p: &MassPoint, t: &Screw) -> Screw {
+pub(crate) fn inertia_times(p: &MassPoint<'_>, t: &Screw) -> Screw {
     Screw::new(
         p.inertia * t[0],
         p.inertia * t[1],
@@ -30,10 +30,10 @@ impl ArmKinematics<'_> {
     pub fn mass_matrix(&self) -> DMatrix<f64> {
         let n = self.arm().n();
         let mut m = DMatrix::zeros(n, n);
-        for p in &self.points {
+        for p in self.points() {
             let cols = p.projection.columns();
             for (a, ca) in cols {
-                let dca = inertia_times(p, ca);
+                let dca = inertia_times(&p, ca);
                 for (b, cb) in cols {
                     m[(*a, *b)] += dca.dot(cb);
                 }
@@ -45,11 +45,10 @@ impl ArmKinematics<'_> {
     /// T = ½ Σ tᵀ D t (eq. 41) at speeds `u`.
     #[must_use]
     pub fn kinetic_energy(&self, u: &[f64]) -> f64 {
-        self.points
-            .iter()
+        self.points()
             .map(|p| {
                 let t = p.projection.twist(u);
-                0.5 * t.dot(&inertia_times(p, &t))
+                0.5 * t.dot(&inertia_times(&p, &t))
             })
             .sum()
     }

@@ -17,8 +17,8 @@
 
 use nalgebra::{DMatrix, Vector2, Vector3};
 
-use crate::arm::{rotate, Pose, Station};
-use crate::screw::{joint_line, line_z, rot_z, screw_n_y, CoordinateTransform, Screw, ScrewTransform};
+use crate::arm::{Pose, Station};
+use crate::screw::{joint_line, line_z, rot_z_cs, screw_n_y, Screw, ScrewTransform};
 
 /// The projection matrix of one station, by its non-zero columns.
 #[derive(Clone, Debug, PartialEq)]
@@ -38,17 +38,17 @@ impl Projection {
     pub fn at(pose: &Pose<'_>, s: &Station) -> Self {
         let arm = pose.arm();
         let i = s.link;
-        let phi_i = pose.chord_angle(i);
         let r = pose.position(s);
         let mut columns = Vec::with_capacity(i + 1 + s.psi.len());
         let mut arms = Vec::with_capacity(i + 1);
+        let line = joint_line();
         for j in 0..=i {
-            let phi_j = pose.chord_angle(j);
             // p_{i_e,j}^j: from the station to joint j, in the coordinates of j.
-            let pj = rotate(-phi_j, &(pose.origin(j) - r));
-            let v = ScrewTransform::new(rot_z(phi_j - phi_i), Vector3::new(pj.x, pj.y, 0.0));
-            columns.push((j, v.apply(&joint_line())));
-            arms.push(rotate(-phi_i, &(r - pose.origin(j))));
+            let pj = pose.to_frame(j, &(pose.origin(j) - r));
+            let (c, sn) = pose.relative_rotation(j, i);
+            let v = ScrewTransform::new(rot_z_cs(c, sn), Vector3::new(pj.x, pj.y, 0.0));
+            columns.push((j, v.apply(&line)));
+            arms.push(pose.to_frame(i, &(r - pose.origin(j))));
         }
         let o = arm.modal_offset(i);
         for (k, (psi, theta)) in s.psi.iter().zip(&s.theta).enumerate() {
@@ -65,7 +65,7 @@ impl Projection {
     /// `P_{0,h/h}^0 = R̄_i^0 P_{0h/h}^i` of eq. 73: the same projection in frame 0.
     #[must_use]
     pub fn in_base_frame(&self, pose: &Pose<'_>) -> Self {
-        let rb = CoordinateTransform::planar(pose.chord_angle(self.link));
+        let rb = pose.screw_to_base(self.link);
         Self {
             columns: self.columns.iter().map(|(k, c)| (*k, rb.apply(c))).collect(),
             ..self.clone()
@@ -90,14 +90,18 @@ impl Projection {
     /// The twist `t = P u`.
     #[must_use]
     pub fn twist(&self, u: &[f64]) -> Screw {
-        self.columns
-            .iter()
-            .fold(Screw::zeros(), |t, (k, c)| t + c * u[*k])
+        let mut t = [0.0; 6];
+        for (k, c) in &self.columns {
+            for (r, tr) in t.iter_mut().enumerate() {
+                *tr += c[r] * u[*k];
+            }
+        }
+        Screw::from(t)
     }
     /// `out += Pᵀ w`.
     pub fn add_transpose_times(&self, w: &Screw, out: &mut [f64]) {
         for (k, c) in &self.columns {
-            out[*k] += c.dot(w);
+            out[*k] += (0..6).map(|r| c[r] * w[r]).sum::<f64>();
         }
     }
     /// The dense 6×n matrix.

@@ -28,10 +28,10 @@
 
 use nalgebra::{DVector, Vector2, Vector3};
 
-use crate::arm::{rotate, z_cross, Station};
+use crate::arm::{z_cross, Station};
 use crate::kinematics::{ArmKinematics, MassPoint};
 use crate::projection::Projection;
-use crate::screw::{interchange, line_x, line_y, rot_z, wrench, CoordinateTransform, Screw, ScrewTransform};
+use crate::screw::{line_x, line_y, rot_z_cs, swap, wrench, Screw, ScrewTransform};
 
 /// A force (frame 0, N) applied at a station of the arm.
 #[derive(Clone, Debug, PartialEq)]
@@ -42,7 +42,7 @@ pub struct PointLoad {
     pub force: Vector2<f64>,
 }
 
-impl MassPoint {
+impl MassPoint<'_> {
     /// Inertial acceleration `[0 0 α a_x a_y 0]` of the point, in its link's frame.
     pub(crate) fn acceleration(&self, u: &[f64], u_dot: &[f64], modal_offset: usize) -> Screw {
         let pv = self.velocity(u, modal_offset);
@@ -56,29 +56,21 @@ impl ArmKinematics<'_> {
     /// The auxiliary projection columns `V_{i_e,j}^{i,j} Π [L_x L_y]` (eq. 88) of joint j for
     /// a point of link i at `r` (frame 0).
     fn auxiliary_columns(&self, i: usize, j: usize, r: &Vector2<f64>) -> [Screw; 2] {
-        let (phi_i, phi_j) = (self.pose.chord_angle(i), self.pose.chord_angle(j));
-        let p = rotate(-phi_j, &(self.pose.origin(j) - r));
-        let v = ScrewTransform::new(rot_z(phi_j - phi_i), Vector3::new(p.x, p.y, 0.0));
-        let pi = interchange();
-        [v.apply(&(pi * line_x())), v.apply(&(pi * line_y()))]
+        let p = self.pose.to_frame(j, &(self.pose.origin(j) - r));
+        let (c, s) = self.pose.relative_rotation(j, i);
+        let v = ScrewTransform::new(rot_z_cs(c, s), Vector3::new(p.x, p.y, 0.0));
+        [v.apply(&swap(&line_x())), v.apply(&swap(&line_y()))]
     }
 
     /// Inertial acceleration of a station in frame 0 at speeds `u` and accelerations `u_dot`.
     #[must_use]
     pub fn point_acceleration(&self, s: &Station, u: &[f64], u_dot: &[f64]) -> Vector2<f64> {
-        let mp = self.mass_point(s, 1.0);
+        let projection = Projection::at(&self.pose, s);
+        let mp = MassPoint { projection: &projection, mass: 1.0, inertia: 0.0, station: s };
         let a = mp.acceleration(u, u_dot, self.arm().modal_offset(s.link));
-        rotate(self.pose.chord_angle(s.link), &Vector2::new(a[3], a[4]))
+        self.pose.to_base(s.link, &Vector2::new(a[3], a[4]))
     }
 
-    fn mass_point(&self, s: &Station, mass: f64) -> MassPoint {
-        MassPoint {
-            projection: Projection::at(&self.pose, s),
-            mass,
-            inertia: 0.0,
-            station: s.clone(),
-        }
-    }
 
     /// The reaction forces ρ (2 per joint, eq. 97) at speeds `u` and accelerations `u_dot`,
     /// with external `loads` and extra point masses `rigid_masses` moving with their stations.
@@ -92,33 +84,44 @@ impl ArmKinematics<'_> {
     ) -> DVector<f64> {
         let arm = self.arm();
         let g = arm.gravity();
-        let pi = interchange();
         let mut rho = DVector::zeros(2 * arm.n_links());
-        let extra: Vec<MassPoint> = rigid_masses
+        let extra: Vec<Projection> = rigid_masses
             .iter()
-            .map(|(s, m)| self.mass_point(s, *m))
+            .map(|(s, _)| Projection::at(&self.pose, s))
             .collect();
-        for p in self.points.iter().chain(&extra) {
+        let extra = rigid_masses.iter().zip(&extra).map(|((s, m), projection)| MassPoint {
+            projection,
+            mass: *m,
+            inertia: 0.0,
+            station: s,
+        });
+        for p in self.points().chain(extra) {
             let i = p.projection.link();
-            let r = self.pose.position(&p.station);
+            let r = self.pose.position(p.station);
             let a = p.acceleration(u, u_dot, arm.modal_offset(i));
-            let d_a = crate::mass_matrix::inertia_times(p, &a);
-            let gw = CoordinateTransform::planar(-self.pose.chord_angle(i))
+            let d_a = crate::mass_matrix::inertia_times(&p, &a);
+            let gw = self
+                .pose
+                .screw_to_frame(i)
                 .apply(&wrench(Vector3::new(0.0, -p.mass * g, 0.0), Vector3::zeros()));
+            let pi_gw = swap(&gw);
             for j in 0..=i {
                 for (c, col) in self.auxiliary_columns(i, j, &r).iter().enumerate() {
-                    rho[2 * j + c] += col.dot(&d_a) - col.dot(&(pi * gw));
+                    rho[2 * j + c] += col.dot(&d_a) - col.dot(&pi_gw);
                 }
             }
         }
         for load in loads {
             let i = load.station.link;
             let r = self.pose.position(&load.station);
-            let w = CoordinateTransform::planar(-self.pose.chord_angle(i))
+            let w = self
+                .pose
+                .screw_to_frame(i)
                 .apply(&wrench(Vector3::new(load.force.x, load.force.y, 0.0), Vector3::zeros()));
+            let pi_w = swap(&w);
             for j in 0..=i {
                 for (c, col) in self.auxiliary_columns(i, j, &r).iter().enumerate() {
-                    rho[2 * j + c] -= col.dot(&(pi * w));
+                    rho[2 * j + c] -= col.dot(&pi_w);
                 }
             }
         }

@@ -20,6 +20,12 @@ pub fn interchange() -> Matrix6<f64> {
     m
 }
 
+/// `Π s`: the halves of a screw swapped, `[f; n] ↦ [n; f]`.
+#[must_use]
+pub fn swap(s: &Screw) -> Screw {
+    Screw::new(s[3], s[4], s[5], s[0], s[1], s[2])
+}
+
 /// The power `tᵀ Π w` of wrench `w` on twist `t`.
 #[must_use]
 pub fn power(t: &Screw, w: &Screw) -> f64 {
@@ -34,6 +40,8 @@ mod tests {
     fn interchange_is_its_own_inverse_and_gives_the_power() {
         let pi = interchange();
         assert_eq!(pi * pi, Matrix6::identity());
+        let s = Screw::new(1.0, 2.0, 3.0, 4.0, 5.0, 6.0);
+        assert_eq!(swap(&s), pi * s);
         let t = Screw::new(0.0, 0.0, 2.0, 1.0, -3.0, 0.0);
         let w = Screw::new(4.0, 5.0, 0.0, 0.0, 0.0, 7.0);
         // ω_z n_z + v·f = 14 + 4 − 15

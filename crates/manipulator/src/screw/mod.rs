@@ -17,8 +17,8 @@ mod transform;
 mod twist;
 mod wrench;
 
-pub use interchange::{interchange, power};
-pub use transform::{rot_z, CoordinateTransform, ReferenceTransform, ScrewTransform};
+pub use interchange::{interchange, power, swap};
+pub use transform::{rot_z, rot_z_cs, CoordinateTransform, ReferenceTransform, ScrewTransform};
 pub use twist::{joint_line, line_x, line_y, line_z, screw_n_x, screw_n_y, screw_n_z, twist};
 pub use wrench::{reaction_basis, screw_basis, wrench};
 

@@ -15,6 +15,30 @@ use super::Screw;
 #[must_use]
 pub fn rot_z(angle: f64) -> Matrix3<f64> {
     let (s, c) = angle.sin_cos();
+    rot_z_cs(c, s)
+}
+
+/// `p × a + m`, written out (the hot path of every projection).
+fn cross_add(p: &Vector3<f64>, a: [f64; 3], m: [f64; 3]) -> [f64; 3] {
+    [
+        p.y * a[2] - p.z * a[1] + m[0],
+        p.z * a[0] - p.x * a[2] + m[1],
+        p.x * a[1] - p.y * a[0] + m[2],
+    ]
+}
+
+/// `R v`, written out.
+fn rotate3(r: &Matrix3<f64>, v: [f64; 3]) -> [f64; 3] {
+    [
+        r.m11 * v[0] + r.m12 * v[1] + r.m13 * v[2],
+        r.m21 * v[0] + r.m22 * v[1] + r.m23 * v[2],
+        r.m31 * v[0] + r.m32 * v[1] + r.m33 * v[2],
+    ]
+}
+
+/// The rotation about z with cosine `c` and sine `s`.
+#[must_use]
+pub fn rot_z_cs(c: f64, s: f64) -> Matrix3<f64> {
     Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
 }
 
@@ -33,9 +57,8 @@ impl ReferenceTransform {
     /// `[a; m] ↦ [a; p × a + m]`.
     #[must_use]
     pub fn apply(&self, s: &Screw) -> Screw {
-        let a = s.fixed_rows::<3>(0).into_owned();
-        let m = s.fixed_rows::<3>(3) + self.p.cross(&a);
-        Screw::new(a.x, a.y, a.z, m.x, m.y, m.z)
+        let m = cross_add(&self.p, [s[0], s[1], s[2]], [s[3], s[4], s[5]]);
+        Screw::new(s[0], s[1], s[2], m[0], m[1], m[2])
     }
     /// The 6×6 matrix `[I 0; p̂ I]`.
     #[must_use]
@@ -71,9 +94,9 @@ impl CoordinateTransform {
     /// `[a; m] ↦ [R a; R m]`.
     #[must_use]
     pub fn apply(&self, s: &Screw) -> Screw {
-        let a = self.r * s.fixed_rows::<3>(0);
-        let m = self.r * s.fixed_rows::<3>(3);
-        Screw::new(a.x, a.y, a.z, m.x, m.y, m.z)
+        let a = rotate3(&self.r, [s[0], s[1], s[2]]);
+        let m = rotate3(&self.r, [s[3], s[4], s[5]]);
+        Screw::new(a[0], a[1], a[2], m[0], m[1], m[2])
     }
     /// The 6×6 matrix `diag(R, R)`.
     #[must_use]
@@ -108,7 +131,10 @@ impl ScrewTransform {
     /// `R̄ U` applied: `[a; m] ↦ [R a; R (p × a + m)]`.
     #[must_use]
     pub fn apply(&self, s: &Screw) -> Screw {
-        CoordinateTransform::new(self.r).apply(&ReferenceTransform::new(self.p).apply(s))
+        let a0 = [s[0], s[1], s[2]];
+        let a = rotate3(&self.r, a0);
+        let m = rotate3(&self.r, cross_add(&self.p, a0, [s[3], s[4], s[5]]));
+        Screw::new(a[0], a[1], a[2], m[0], m[1], m[2])
     }
     /// The 6×6 matrix `R̄ U`.
     #[must_use]
