@@ -72,3 +72,42 @@ impl Rng {
         (0..n).map(|_| self.uniform(-scale, scale)).collect()
     }
 }
+
+/// Newton's method with a central-difference Jacobian for f(x) = 0 (small dense systems).
+pub fn newton(mut x: Vec<f64>, f: impl Fn(&[f64]) -> Vec<f64>, scale: &[f64]) -> Vec<f64> {
+    let n = x.len();
+    for _ in 0..50 {
+        let r = f(&x);
+        let mut j = nalgebra::DMatrix::zeros(n, n);
+        for k in 0..n {
+            let h = 1e-6 * scale[k];
+            let (mut xp, mut xm) = (x.clone(), x.clone());
+            xp[k] += h;
+            xm[k] -= h;
+            let (fp, fm) = (f(&xp), f(&xm));
+            for i in 0..n {
+                j[(i, k)] = (fp[i] - fm[i]) / (2.0 * h);
+            }
+        }
+        let dx = j.lu().solve(&nalgebra::DVector::from_vec(r)).unwrap();
+        let mut small = true;
+        for k in 0..n {
+            x[k] -= dx[k];
+            small &= dx[k].abs() <= 1e-14 * scale[k].max(x[k].abs());
+        }
+        if small {
+            break;
+        }
+    }
+    x
+}
+
+/// The static cylinder forces of the rigid crane: the first two rows of τ_b F + G = 0.
+pub fn static_forces(arm: &PlanarArm, q: &[f64]) -> [f64; 2] {
+    let pose = arm.pose(q);
+    let tau = arm.actuator_jacobian(&pose, &cylinders());
+    let g = arm.kinematics(q).gravity_forces();
+    let a = nalgebra::Matrix2::new(tau[(0, 0)], tau[(0, 1)], tau[(1, 0)], tau[(1, 1)]);
+    let f = a.lu().solve(&nalgebra::Vector2::new(-g[0], -g[1])).unwrap();
+    [f.x, f.y]
+}
