@@ -8,5 +8,6 @@ use bg_model::Registry;
 pub fn registry() -> Registry {
     let mut r = Registry::with_core();
     bg_hydraulics::register(&mut r);
+    bg_manipulator::register(&mut r);
     r
 }
