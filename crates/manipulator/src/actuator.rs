@@ -51,11 +51,18 @@ impl PlanarArm {
         self.check_pin(&act.a)?;
         self.check_pin(&act.b)?;
         if q.len() != self.n() {
-            return Err(ManipulatorError::shape("q0", format!("needs {} values", self.n())));
+            return Err(ManipulatorError::shape(
+                "q0",
+                format!("needs {} values", self.n()),
+            ));
         }
         let l = act.length(&self.pose(q));
         if !(l.is_finite() && l > 0.0) {
-            return Err(ManipulatorError::invalid("actuator length", l, "> 0: the pins coincide"));
+            return Err(ManipulatorError::invalid(
+                "actuator length",
+                l,
+                "> 0: the pins coincide",
+            ));
         }
         Ok(())
     }
@@ -85,7 +92,8 @@ impl PlanarArm {
         let mut t = DMatrix::zeros(self.n(), acts.len());
         for (c, act) in acts.iter().enumerate() {
             let e = act.direction(pose);
-            let col = self.generalized_force(pose, &act.b, &e) - self.generalized_force(pose, &act.a, &e);
+            let col =
+                self.generalized_force(pose, &act.b, &e) - self.generalized_force(pose, &act.a, &e);
             t.column_mut(c).copy_from(&col);
         }
         t

@@ -11,7 +11,7 @@
 //! frame 0 for i = 1, at the end of link i−1's chord otherwise; its x axis runs along link
 //! i's chord at the angle `φ_i = q_1 + … + q_i` from x₀.
 
-use std::cell::RefCell;
+use std::sync::Mutex;
 
 use nalgebra::Vector2;
 
@@ -45,7 +45,7 @@ pub(crate) struct MassStation {
 }
 
 /// A planar serial manipulator.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct PlanarArm {
     links: Vec<Link>,
     joint: RevoluteJoint,
@@ -54,7 +54,22 @@ pub struct PlanarArm {
     modal_offset: Vec<usize>,
     n: usize,
     mass_stations: Vec<MassStation>,
-    cache: RefCell<ProjectionCache>,
+    cache: Mutex<ProjectionCache>,
+}
+
+impl Clone for PlanarArm {
+    fn clone(&self) -> Self {
+        Self {
+            links: self.links.clone(),
+            joint: self.joint,
+            gravity: self.gravity,
+            quadrature: self.quadrature.clone(),
+            modal_offset: self.modal_offset.clone(),
+            n: self.n,
+            mass_stations: self.mass_stations.clone(),
+            cache: Mutex::new(None),
+        }
+    }
 }
 
 impl PlanarArm {
@@ -71,7 +86,10 @@ impl PlanarArm {
         points: usize,
     ) -> Result<Self, ManipulatorError> {
         if links.is_empty() {
-            return Err(ManipulatorError::shape("links", "an arm needs at least one link"));
+            return Err(ManipulatorError::shape(
+                "links",
+                "an arm needs at least one link",
+            ));
         }
         ManipulatorError::finite("gravity", gravity)?;
         let quadrature = GaussLegendre::new(points)?;
@@ -89,7 +107,7 @@ impl PlanarArm {
             modal_offset,
             n,
             mass_stations: Vec::new(),
-            cache: RefCell::new(None),
+            cache: Mutex::new(None),
         };
         arm.mass_stations = arm.build_mass_stations();
         Ok(arm)
@@ -161,7 +179,7 @@ impl PlanarArm {
     pub(crate) fn mass_stations(&self) -> &[MassStation] {
         &self.mass_stations
     }
-    pub(crate) fn projection_cache(&self) -> &RefCell<ProjectionCache> {
+    pub(crate) fn projection_cache(&self) -> &Mutex<ProjectionCache> {
         &self.cache
     }
 
@@ -180,11 +198,19 @@ impl PlanarArm {
         let l = self.links.get(link).ok_or_else(|| {
             ManipulatorError::shape(
                 "link",
-                format!("link {} does not exist (the arm has {})", link + 1, self.links.len()),
+                format!(
+                    "link {} does not exist (the arm has {})",
+                    link + 1,
+                    self.links.len()
+                ),
             )
         })?;
         if !(x.is_finite() && (0.0..=l.length()).contains(&x)) {
-            return Err(ManipulatorError::invalid("x", x, "on the link, 0 <= x <= L"));
+            return Err(ManipulatorError::invalid(
+                "x",
+                x,
+                "on the link, 0 <= x <= L",
+            ));
         }
         Ok(self.station_unchecked(link, x))
     }
@@ -217,7 +243,13 @@ impl PlanarArm {
     /// If `q.len() != self.n()`.
     #[must_use]
     pub fn pose<'a>(&'a self, q: &'a [f64]) -> Pose<'a> {
-        assert_eq!(q.len(), self.n, "q has {} entries, the arm {}", q.len(), self.n);
+        assert_eq!(
+            q.len(),
+            self.n,
+            "q has {} entries, the arm {}",
+            q.len(),
+            self.n
+        );
         let nl = self.links.len();
         let mut phi = Vec::with_capacity(nl);
         let mut cs = Vec::with_capacity(nl);
@@ -314,12 +346,20 @@ impl<'a> Pose<'a> {
     /// Deflection `w(x)` at a station.
     #[must_use]
     pub fn deflection(&self, s: &Station) -> f64 {
-        s.psi.iter().zip(self.modal(s.link)).map(|(p, q)| p * q).sum()
+        s.psi
+            .iter()
+            .zip(self.modal(s.link))
+            .map(|(p, q)| p * q)
+            .sum()
     }
     /// Rotation `θ(x) = w'(x)` of the cross-section at a station.
     #[must_use]
     pub fn slope(&self, s: &Station) -> f64 {
-        s.theta.iter().zip(self.modal(s.link)).map(|(p, q)| p * q).sum()
+        s.theta
+            .iter()
+            .zip(self.modal(s.link))
+            .map(|(p, q)| p * q)
+            .sum()
     }
     /// Position of a station in its link's frame: `(x, w(x))`.
     #[must_use]
@@ -356,8 +396,14 @@ mod tests {
 
     #[test]
     fn coordinates_and_frames_of_the_knuckle_boom() {
-        let l1 = Link::beam(10.0, 210e9, 7850.0, 0.0264, 5.89e-4).unwrap().with_sine_modes(3).unwrap();
-        let l2 = Link::beam(8.0, 210e9, 7850.0, 0.0264, 5.89e-4).unwrap().with_sine_modes(3).unwrap();
+        let l1 = Link::beam(10.0, 210e9, 7850.0, 0.0264, 5.89e-4)
+            .unwrap()
+            .with_sine_modes(3)
+            .unwrap();
+        let l2 = Link::beam(8.0, 210e9, 7850.0, 0.0264, 5.89e-4)
+            .unwrap()
+            .with_sine_modes(3)
+            .unwrap();
         let l3 = Link::pendulum(6.0, 5000.0).unwrap();
         let arm = PlanarArm::new(vec![l1, l2, l3], 9.81).unwrap();
         assert_eq!(arm.n(), 9);

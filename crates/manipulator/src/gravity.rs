@@ -17,9 +17,13 @@ impl ArmKinematics<'_> {
         let arm = self.arm();
         let mut g = DVector::zeros(arm.n());
         for p in self.points() {
-            let w0 = wrench(Vector3::new(0.0, -p.mass * arm.gravity(), 0.0), Vector3::zeros());
+            let w0 = wrench(
+                Vector3::new(0.0, -p.mass * arm.gravity(), 0.0),
+                Vector3::zeros(),
+            );
             let wi = self.pose.screw_to_frame(p.projection.link()).apply(&w0);
-            p.projection.add_transpose_times(&swap(&wi), g.as_mut_slice());
+            p.projection
+                .add_transpose_times(&swap(&wi), g.as_mut_slice());
         }
         g
     }

@@ -41,7 +41,11 @@ impl PlanarArm {
     #[must_use]
     pub fn kinematics<'a>(&'a self, q: &'a [f64]) -> ArmKinematics<'a> {
         let pose = self.pose(q);
-        let mut cache = self.projection_cache().borrow_mut();
+        // A poisoned cache only means another thread panicked while filling it: refill it.
+        let mut cache = self
+            .projection_cache()
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
         let projections = match cache.as_ref() {
             Some((key, p)) if key.as_slice() == q => p.clone(),
             _ => {

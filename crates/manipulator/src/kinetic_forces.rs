@@ -98,7 +98,13 @@ impl ArmKinematics<'_> {
             let pv = p.velocity_with(u, o, |k, dv, v| e[k] += p.mass * v.dot(&dv));
             // Ṗᵀ D t
             let d = p.projection.arms();
-            let w_dot: f64 = p.station.psi.iter().enumerate().map(|(k, s)| s * u[o + k]).sum();
+            let w_dot: f64 = p
+                .station
+                .psi
+                .iter()
+                .enumerate()
+                .map(|(k, s)| s * u[o + k])
+                .sum();
             for j in 0..=i {
                 let mut d_dot = Vector2::new(0.0, w_dot);
                 for k in j + 1..=i {

@@ -196,7 +196,11 @@ mod tests {
         assert!(Link::rigid(1.0, 1.0).unwrap().with_sine_modes(1).is_err()); // no EI
         let l = Link::rigid(2.0, 1.0).unwrap();
         assert!(l
-            .with_point_mass(PointMass { x: 2.5, mass: 1.0, inertia: 0.0 })
+            .with_point_mass(PointMass {
+                x: 2.5,
+                mass: 1.0,
+                inertia: 0.0
+            })
             .is_err());
     }
 

@@ -42,7 +42,9 @@ impl PlanarArm {
         match *pin {
             Pin::Ground(_) => DMatrix::zeros(2, self.n()),
             Pin::Link { link, x } => match self.station(link, x) {
-                Ok(s) => Projection::at(pose, &s).in_base_frame(pose).velocity_jacobian(),
+                Ok(s) => Projection::at(pose, &s)
+                    .in_base_frame(pose)
+                    .velocity_jacobian(),
                 Err(_) => DMatrix::zeros(2, self.n()),
             },
         }
@@ -53,7 +55,8 @@ impl PlanarArm {
     pub fn lumped_mass_jacobian(&self, pose: &Pose<'_>, pins: &[Pin]) -> DMatrix<f64> {
         let mut j = DMatrix::zeros(2 * pins.len(), self.n());
         for (k, pin) in pins.iter().enumerate() {
-            j.rows_mut(2 * k, 2).copy_from(&self.pin_jacobian(pose, pin));
+            j.rows_mut(2 * k, 2)
+                .copy_from(&self.pin_jacobian(pose, pin));
         }
         j
     }

@@ -122,7 +122,10 @@ mod tests {
             for d in 0..2 * n {
                 let got = q.integrate(3.0, |x| x.powi(d as i32));
                 let exact = 3.0f64.powi(d as i32 + 1) / (d as f64 + 1.0);
-                assert!((got - exact).abs() < 1e-13 * exact, "n {n} degree {d}: {got} vs {exact}");
+                assert!(
+                    (got - exact).abs() < 1e-13 * exact,
+                    "n {n} degree {d}: {got} vs {exact}"
+                );
             }
             // and not for degree 2n
             let d = 2 * n as i32;

@@ -66,11 +66,15 @@ impl ArmKinematics<'_> {
     #[must_use]
     pub fn point_acceleration(&self, s: &Station, u: &[f64], u_dot: &[f64]) -> Vector2<f64> {
         let projection = Projection::at(&self.pose, s);
-        let mp = MassPoint { projection: &projection, mass: 1.0, inertia: 0.0, station: s };
+        let mp = MassPoint {
+            projection: &projection,
+            mass: 1.0,
+            inertia: 0.0,
+            station: s,
+        };
         let a = mp.acceleration(u, u_dot, self.arm().modal_offset(s.link));
         self.pose.to_base(s.link, &Vector2::new(a[3], a[4]))
     }
-
 
     /// The reaction forces ρ (2 per joint, eq. 97) at speeds `u` and accelerations `u_dot`,
     /// with external `loads` and extra point masses `rigid_masses` moving with their stations.
@@ -89,21 +93,24 @@ impl ArmKinematics<'_> {
             .iter()
             .map(|(s, _)| Projection::at(&self.pose, s))
             .collect();
-        let extra = rigid_masses.iter().zip(&extra).map(|((s, m), projection)| MassPoint {
-            projection,
-            mass: *m,
-            inertia: 0.0,
-            station: s,
-        });
+        let extra = rigid_masses
+            .iter()
+            .zip(&extra)
+            .map(|((s, m), projection)| MassPoint {
+                projection,
+                mass: *m,
+                inertia: 0.0,
+                station: s,
+            });
         for p in self.points().chain(extra) {
             let i = p.projection.link();
             let r = self.pose.position(p.station);
             let a = p.acceleration(u, u_dot, arm.modal_offset(i));
             let d_a = crate::mass_matrix::inertia_times(&p, &a);
-            let gw = self
-                .pose
-                .screw_to_frame(i)
-                .apply(&wrench(Vector3::new(0.0, -p.mass * g, 0.0), Vector3::zeros()));
+            let gw = self.pose.screw_to_frame(i).apply(&wrench(
+                Vector3::new(0.0, -p.mass * g, 0.0),
+                Vector3::zeros(),
+            ));
             let pi_gw = swap(&gw);
             for j in 0..=i {
                 for (c, col) in self.auxiliary_columns(i, j, &r).iter().enumerate() {
@@ -114,10 +121,10 @@ impl ArmKinematics<'_> {
         for load in loads {
             let i = load.station.link;
             let r = self.pose.position(&load.station);
-            let w = self
-                .pose
-                .screw_to_frame(i)
-                .apply(&wrench(Vector3::new(load.force.x, load.force.y, 0.0), Vector3::zeros()));
+            let w = self.pose.screw_to_frame(i).apply(&wrench(
+                Vector3::new(load.force.x, load.force.y, 0.0),
+                Vector3::zeros(),
+            ));
             let pi_w = swap(&w);
             for j in 0..=i {
                 for (c, col) in self.auxiliary_columns(i, j, &r).iter().enumerate() {

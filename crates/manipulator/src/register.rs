@@ -53,7 +53,9 @@ pub fn register(registry: &mut Registry) {
 
 fn build_planar_arm(s: &ElementSpec<'_>) -> Result<Composite, ModelError> {
     let scene = scene(s)?;
-    scene.composite(&|l| s.member(l)).map_err(|e| s.param_error(&e))
+    scene
+        .composite(&|l| s.member(l))
+        .map_err(|e| s.param_error(&e))
 }
 
 /// A nested TOML table read key by key, with unknown keys reported.
@@ -66,7 +68,12 @@ struct Table<'a, 's> {
 }
 
 impl<'a, 's> Table<'a, 's> {
-    fn new(spec: &'a ElementSpec<'s>, key: &'a str, path: String, v: &'a Value) -> Result<Self, ModelError> {
+    fn new(
+        spec: &'a ElementSpec<'s>,
+        key: &'a str,
+        path: String,
+        v: &'a Value,
+    ) -> Result<Self, ModelError> {
         match v {
             Value::Table(table) => Ok(Self {
                 spec,
@@ -75,7 +82,11 @@ impl<'a, 's> Table<'a, 's> {
                 table,
                 asked: RefCell::new(Vec::new()),
             }),
-            other => Err(bad(spec, key, format!("`{path}` must be a table {{ … }}, not {}", other.type_str()))),
+            other => Err(bad(
+                spec,
+                key,
+                format!("`{path}` must be a table {{ … }}, not {}", other.type_str()),
+            )),
         }
     }
     fn get(&self, k: &str) -> Option<&'a Value> {
@@ -97,14 +108,22 @@ impl<'a, 's> Table<'a, 's> {
         match self.get(k) {
             None => Ok(default),
             Some(Value::String(s)) => Ok(s),
-            Some(_) => Err(bad(self.spec, self.key, format!("`{}.{k}` must be a string", self.path))),
+            Some(_) => Err(bad(
+                self.spec,
+                self.key,
+                format!("`{}.{k}` must be a string", self.path),
+            )),
         }
     }
     /// A 1-based link number as a 0-based index.
     fn link(&self, k: &str) -> Result<usize, ModelError> {
         let v = self.num(k)?;
         if v.fract() != 0.0 || v < 1.0 {
-            return Err(bad(self.spec, self.key, format!("`{}.{k}` = {v} must be a link number 1, 2, …", self.path)));
+            return Err(bad(
+                self.spec,
+                self.key,
+                format!("`{}.{k}` = {v} must be a link number 1, 2, …", self.path),
+            ));
         }
         Ok(v as usize - 1)
     }
@@ -113,7 +132,11 @@ impl<'a, 's> Table<'a, 's> {
         match self.table.keys().find(|k| !asked.contains(k)) {
             None => Ok(()),
             Some(k) => {
-                let mut e = bad(self.spec, self.key, format!("`{}` has an unknown key `{k}`", self.path));
+                let mut e = bad(
+                    self.spec,
+                    self.key,
+                    format!("`{}` has an unknown key `{k}`", self.path),
+                );
                 e.hint = Some(format!("`{}` takes: {}", self.path, asked.join(", ")));
                 Err(e)
             }
@@ -122,7 +145,11 @@ impl<'a, 's> Table<'a, 's> {
 }
 
 fn bad(s: &ElementSpec<'_>, key: &str, message: String) -> ModelError {
-    s.error(key, ErrorKind::BadParameter, format!("({}) {message}", s.kind))
+    s.error(
+        key,
+        ErrorKind::BadParameter,
+        format!("({}) {message}", s.kind),
+    )
 }
 
 /// A constant number: a TOML number or an expression of the model's parameters.
@@ -131,19 +158,34 @@ fn number(s: &ElementSpec<'_>, key: &str, path: &str, v: &Value) -> Result<f64, 
         Value::Float(f) => *f,
         Value::Integer(i) => *i as f64,
         Value::String(text) => {
-            let e = Expr::parse(text).map_err(|e| bad(s, key, format!("cannot read `{path}` = \"{text}\": {e}")))?;
+            let e = Expr::parse(text)
+                .map_err(|e| bad(s, key, format!("cannot read `{path}` = \"{text}\": {e}")))?;
             let (c, inputs) = s.compile(key, &e)?;
             if let Some(n) = inputs.first() {
-                return Err(bad(s, key, format!("`{path}` must be constant, but reads `{n}`")));
+                return Err(bad(
+                    s,
+                    key,
+                    format!("`{path}` must be constant, but reads `{n}`"),
+                ));
             }
             c.eval(&[])
         }
-        other => return Err(bad(s, key, format!("`{path}` must be a number, not {}", other.type_str()))),
+        other => {
+            return Err(bad(
+                s,
+                key,
+                format!("`{path}` must be a number, not {}", other.type_str()),
+            ))
+        }
     };
     if x.is_finite() {
         Ok(x)
     } else {
-        Err(bad(s, key, format!("`{path}` evaluates to {x}, which is not finite")))
+        Err(bad(
+            s,
+            key,
+            format!("`{path}` evaluates to {x}, which is not finite"),
+        ))
     }
 }
 
@@ -152,7 +194,11 @@ fn array<'a>(s: &'a ElementSpec<'_>, key: &str) -> Result<&'a [Value], ModelErro
     match s.raw(key) {
         None => Ok(&[]),
         Some(Value::Array(a)) => Ok(a),
-        Some(other) => Err(bad(s, key, format!("`{key}` must be an array [ … ], not {}", other.type_str()))),
+        Some(other) => Err(bad(
+            s,
+            key,
+            format!("`{key}` must be an array [ … ], not {}", other.type_str()),
+        )),
     }
 }
 
@@ -162,28 +208,54 @@ fn link(s: &ElementSpec<'_>, k: usize, v: &Value) -> Result<Link, ModelError> {
     let length = t.num("length")?;
     let mut l = match t.str_or("type", "beam")? {
         "beam" => {
-            let beam = Link::beam(length, t.num("E")?, t.num("rho")?, t.num("A")?, t.num("I")?).map_err(fail)?;
+            let beam = Link::beam(length, t.num("E")?, t.num("rho")?, t.num("A")?, t.num("I")?)
+                .map_err(fail)?;
             let modes = t.num_or("modes", 0.0)?;
             if modes.fract() != 0.0 || !(0.0..=64.0).contains(&modes) {
-                return Err(bad(s, "links", format!("links[{}].modes = {modes} must be an integer 0..=64", k + 1)));
+                return Err(bad(
+                    s,
+                    "links",
+                    format!("links[{}].modes = {modes} must be an integer 0..=64", k + 1),
+                ));
             }
             beam.with_sine_modes(modes as u32).map_err(fail)?
         }
         "rigid" => {
-            let (m, j) = (t.num_or("mass_per_length", 0.0)?, t.num_or("rotary_inertia_per_length", 0.0)?);
-            Link::rigid(length, m).and_then(|l| l.with_rotary_inertia(j)).map_err(fail)?
+            let (m, j) = (
+                t.num_or("mass_per_length", 0.0)?,
+                t.num_or("rotary_inertia_per_length", 0.0)?,
+            );
+            Link::rigid(length, m)
+                .and_then(|l| l.with_rotary_inertia(j))
+                .map_err(fail)?
         }
         "pendulum" => Link::pendulum(length, t.num("mass")?).map_err(fail)?,
         other => {
-            return Err(bad(s, "links", format!("links[{}].type = \"{other}\": use \"beam\", \"rigid\" or \"pendulum\"", k + 1)));
+            return Err(bad(
+                s,
+                "links",
+                format!(
+                    "links[{}].type = \"{other}\": use \"beam\", \"rigid\" or \"pendulum\"",
+                    k + 1
+                ),
+            ));
         }
     };
     if let Some(pm) = t.get("point_masses") {
         let Value::Array(items) = pm else {
-            return Err(bad(s, "links", format!("links[{}].point_masses must be an array", k + 1)));
+            return Err(bad(
+                s,
+                "links",
+                format!("links[{}].point_masses must be an array", k + 1),
+            ));
         };
         for (m, item) in items.iter().enumerate() {
-            let p = Table::new(s, "links", format!("links[{}].point_masses[{}]", k + 1, m + 1), item)?;
+            let p = Table::new(
+                s,
+                "links",
+                format!("links[{}].point_masses[{}]", k + 1, m + 1),
+                item,
+            )?;
             let mass = PointMass {
                 x: p.num("x")?,
                 mass: p.num("mass")?,
@@ -201,7 +273,13 @@ fn pin(t: &Table<'_, '_>) -> Result<Pin, ModelError> {
     if let Some(g) = t.get("ground") {
         let xy = match g {
             Value::Array(a) if a.len() == 2 => a,
-            _ => return Err(bad(t.spec, t.key, format!("`{}.ground` must be [x, y]", t.path))),
+            _ => {
+                return Err(bad(
+                    t.spec,
+                    t.key,
+                    format!("`{}.ground` must be [x, y]", t.path),
+                ))
+            }
         };
         let x = number(t.spec, t.key, &format!("{}.ground[1]", t.path), &xy[0])?;
         let y = number(t.spec, t.key, &format!("{}.ground[2]", t.path), &xy[1])?;
@@ -217,12 +295,20 @@ fn scene(s: &ElementSpec<'_>) -> Result<ArmScene, ModelError> {
         .map(|(k, v)| link(s, k, v))
         .collect::<Result<Vec<_>, _>>()?;
     if links.is_empty() {
-        return Err(bad(s, "links", "needs `links = [ … ]` with at least one link".into()));
+        return Err(bad(
+            s,
+            "links",
+            "needs `links = [ … ]` with at least one link".into(),
+        ));
     }
     let mut scene = ArmScene::new(links, s.number_or("gravity", 9.81)?);
     let points = s.number_or("quadrature_points", scene.quadrature_points as f64)?;
     if points.fract() != 0.0 || !(1.0..=512.0).contains(&points) {
-        return Err(bad(s, "quadrature_points", format!("`quadrature_points` = {points} must be an integer 1..=512")));
+        return Err(bad(
+            s,
+            "quadrature_points",
+            format!("`quadrature_points` = {points} must be an integer 1..=512"),
+        ));
     }
     scene.quadrature_points = points as usize;
     scene.q0 = s.vector_or("q0", Vec::new())?;
@@ -231,7 +317,13 @@ fn scene(s: &ElementSpec<'_>) -> Result<ArmScene, ModelError> {
     for (k, v) in array(s, "actuators")?.iter().enumerate() {
         let t = Table::new(s, "actuators", format!("actuators[{}]", k + 1), v)?;
         let ends = ["from", "to"].map(|e| {
-            let v = t.get(e).ok_or_else(|| bad(s, "actuators", format!("`actuators[{}]` needs `{e}`", k + 1)))?;
+            let v = t.get(e).ok_or_else(|| {
+                bad(
+                    s,
+                    "actuators",
+                    format!("`actuators[{}]` needs `{e}`", k + 1),
+                )
+            })?;
             let p = Table::new(s, "actuators", format!("actuators[{}].{e}", k + 1), v)?;
             let pin = pin(&p)?;
             p.finish()?;
@@ -255,7 +347,10 @@ fn scene(s: &ElementSpec<'_>) -> Result<ArmScene, ModelError> {
                 LumpedMassModel::Omitted
             } else {
                 LumpedMassModel::Springs {
-                    stiffness: s.number("lumped_stiffness", "spring stiffness of the lumped masses, N/m")?,
+                    stiffness: s.number(
+                        "lumped_stiffness",
+                        "spring stiffness of the lumped masses, N/m",
+                    )?,
                     damping: s.number_or("lumped_damping", 0.0)?,
                 }
             }
@@ -263,7 +358,11 @@ fn scene(s: &ElementSpec<'_>) -> Result<ArmScene, ModelError> {
         "rigid" => LumpedMassModel::Rigid,
         "none" => LumpedMassModel::Omitted,
         other => {
-            return Err(bad(s, "lumped_model", format!("`lumped_model` = \"{other}\": use \"springs\", \"rigid\" or \"none\"")));
+            return Err(bad(
+                s,
+                "lumped_model",
+                format!("`lumped_model` = \"{other}\": use \"springs\", \"rigid\" or \"none\""),
+            ));
         }
     };
     Ok(scene)

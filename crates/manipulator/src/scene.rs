@@ -24,8 +24,7 @@ use std::sync::Arc;
 
 use bg_model::Composite;
 use bondgraph::{
-    BondGraph, Capacitor, ElementId, GraphError, OneJunction, ParamError, Resistor,
-    ZeroJunction,
+    BondGraph, Capacitor, ElementId, GraphError, OneJunction, ParamError, Resistor, ZeroJunction,
 };
 use nalgebra::DVector;
 
@@ -120,12 +119,22 @@ impl ArmScene {
         if self.lumped_model == LumpedMassModel::Rigid {
             for m in &self.lumped_masses {
                 let crate::Pin::Link { link, x } = m.pin else {
-                    return Err(ManipulatorError::shape("lumped_masses", "a lumped mass must sit on a link"));
+                    return Err(ManipulatorError::shape(
+                        "lumped_masses",
+                        "a lumped mass must sit on a link",
+                    ));
                 };
                 let l = links.get_mut(link).ok_or_else(|| {
-                    ManipulatorError::shape("lumped_masses", format!("link {} does not exist", link + 1))
+                    ManipulatorError::shape(
+                        "lumped_masses",
+                        format!("link {} does not exist", link + 1),
+                    )
                 })?;
-                *l = l.clone().with_point_mass(PointMass { x, mass: m.mass, inertia: 0.0 })?;
+                *l = l.clone().with_point_mass(PointMass {
+                    x,
+                    mass: m.mass,
+                    inertia: 0.0,
+                })?;
             }
         }
         PlanarArm::with_quadrature(links, self.gravity, self.quadrature_points)
@@ -159,7 +168,8 @@ impl ArmScene {
         let mut forces = Vec::new();
         for (k, act) in self.actuators.iter().enumerate() {
             let (name, cyl) = (format!("act{}", k + 1), format!("cyl{}", k + 1));
-            let mtf = ActuatorTransformer::new(arm.clone(), vec![*act], &q, &q0)?.numbered_from(k + 1);
+            let mtf =
+                ActuatorTransformer::new(arm.clone(), vec![*act], &q, &q0)?.numbered_from(k + 1);
             c.element(&name, mtf)
                 .bond(&format!("b_{name}"), &format!("{name}.1"), "j")
                 .port(&cyl, &format!("{name}.2"));
@@ -172,12 +182,16 @@ impl ArmScene {
             ManipulatorError::positive("lumped_stiffness", stiffness)?;
             let pins: Vec<_> = springs.iter().map(|m| m.pin).collect();
             let masses: Vec<f64> = springs.iter().map(|m| m.mass).collect();
-            let v0 = arm.lumped_mass_jacobian(&arm.pose(&q0), &pins) * DVector::from_column_slice(&u0);
+            let v0 =
+                arm.lumped_mass_jacobian(&arm.pose(&q0), &pins) * DVector::from_column_slice(&u0);
             c.element("lump", LumpedMassTransformer::new(arm.clone(), pins, &q)?)
                 .element("pins", OneJunction)
                 .element("link", ZeroJunction)
                 .element("rel", OneJunction)
-                .element("spring", Capacitor::multi(1.0 / stiffness, vec![0.0; 2 * masses.len()])?)
+                .element(
+                    "spring",
+                    Capacitor::multi(1.0 / stiffness, vec![0.0; 2 * masses.len()])?,
+                )
                 .element("damper", Resistor::new(damping)?)
                 .element("masses_j", OneJunction)
                 .element("masses", LumpedMasses::new(masses.clone(), v0.as_slice())?)
@@ -201,7 +215,10 @@ impl ArmScene {
             forces,
             pin_forces,
         };
-        c.element("rho", ArmReactions::new(arm, &self.actuators, &springs, inputs)?);
+        c.element(
+            "rho",
+            ArmReactions::new(arm, &self.actuators, &springs, inputs)?,
+        );
         Ok(c)
     }
 
@@ -219,7 +236,9 @@ impl ArmScene {
         }
         let end = |g: &BondGraph, s: &str| -> Result<(ElementId, Option<usize>), GraphError> {
             let (el, port) = s.split_once('.').map_or((s, None), |(e, p)| (e, Some(p)));
-            let id = g.find(&global(el)).ok_or_else(|| GraphError::UnknownElement { name: global(el) })?;
+            let id = g
+                .find(&global(el))
+                .ok_or_else(|| GraphError::UnknownElement { name: global(el) })?;
             Ok((id, port.map(|p| g.port_index(id, p)).transpose()?))
         };
         for (b, from, to) in &c.bonds {

@@ -47,11 +47,18 @@ fn tau_b_and_j_c_match_finite_differences() {
             let (pp, pm) = (arm.pose(&qp), arm.pose(&qm));
             for (c, a) in acts.iter().enumerate() {
                 let fd = (a.length(&pp) - a.length(&pm)) / (2.0 * h);
-                assert!((fd - tau[(k, c)]).abs() < 1e-7, "τ_b[{k},{c}] = {} vs {fd}", tau[(k, c)]);
+                assert!(
+                    (fd - tau[(k, c)]).abs() < 1e-7,
+                    "τ_b[{k},{c}] = {} vs {fd}",
+                    tau[(k, c)]
+                );
             }
             for (m, pin) in pins.iter().enumerate() {
                 let fd = (pp.pin_position(pin) - pm.pin_position(pin)) / (2.0 * h);
-                assert!((fd.x - jc[(2 * m, k)]).abs() < 1e-7 && (fd.y - jc[(2 * m + 1, k)]).abs() < 1e-7);
+                assert!(
+                    (fd.x - jc[(2 * m, k)]).abs() < 1e-7
+                        && (fd.y - jc[(2 * m + 1, k)]).abs() < 1e-7
+                );
             }
         }
     }
@@ -62,12 +69,21 @@ fn both_mtfs_conserve_power_at_random_states() {
     let mut scene = ArmScene::new(crane_links(3), G);
     scene.actuators = cylinders();
     scene.lumped_masses = lumped_masses();
-    scene.lumped_model = LumpedMassModel::Springs { stiffness: 1e8, damping: 2e5 };
+    scene.lumped_model = LumpedMassModel::Springs {
+        stiffness: 1e8,
+        damping: 2e5,
+    };
     let mut g = BondGraph::new();
     let ports = scene.add_to(&mut g, "crane").unwrap();
     for (k, f) in [2.1e5, -8.0e4].iter().enumerate() {
-        let se = g.add(&format!("F{}", k + 1), EffortSource::new(*f)).unwrap();
-        let (_, id, port) = ports.iter().find(|p| p.0 == format!("cyl{}", k + 1)).unwrap().clone();
+        let se = g
+            .add(&format!("F{}", k + 1), EffortSource::new(*f))
+            .unwrap();
+        let (_, id, port) = ports
+            .iter()
+            .find(|p| p.0 == format!("cyl{}", k + 1))
+            .unwrap()
+            .clone();
         g.connect((se, None), (id, port)).unwrap();
     }
     let eqs = StateEquations::new(assign_causality(g).unwrap()).unwrap();
@@ -79,7 +95,11 @@ fn both_mtfs_conserve_power_at_random_states() {
             .map(|s| {
                 if s.name.starts_with("crane_arm.q[") {
                     let k: usize = s.name[12..s.name.len() - 1].parse().unwrap();
-                    if k < 3 { initial_pose(0)[k] + rng.uniform(-0.3, 0.3) } else { rng.uniform(-0.05, 0.05) }
+                    if k < 3 {
+                        initial_pose(0)[k] + rng.uniform(-0.3, 0.3)
+                    } else {
+                        rng.uniform(-0.05, 0.05)
+                    }
                 } else {
                     s.nominal * rng.uniform(-1.0, 1.0)
                 }

@@ -44,7 +44,11 @@ fn e_matches_central_differences_of_kinetic_energy() {
         let scale = e.abs().max().max(1.0);
         for k in 0..arm.n() {
             let fd = central(&q, k, 1e-6, t);
-            assert!((fd - e[k]).abs() < 1e-6 * scale, "E[{k}] = {} vs {fd}", e[k]);
+            assert!(
+                (fd - e[k]).abs() < 1e-6 * scale,
+                "E[{k}] = {} vs {fd}",
+                e[k]
+            );
         }
         assert!(e[0].abs() < 1e-9 * scale, "T does not depend on q1");
     }
@@ -61,7 +65,8 @@ fn mdot_u_matches_differences_of_m_along_u() {
         let h = 1e-6;
         let shifted = |s: f64| -> Vec<f64> { q.iter().zip(&u).map(|(a, b)| a + s * b).collect() };
         let (qp, qm) = (shifted(h), shifted(-h));
-        let dm = (arm.kinematics(&qp).mass_matrix() - arm.kinematics(&qm).mass_matrix()) / (2.0 * h);
+        let dm =
+            (arm.kinematics(&qp).mass_matrix() - arm.kinematics(&qm).mass_matrix()) / (2.0 * h);
         let fd = dm * DVector::from_column_slice(&u);
         let scale = fd.abs().max().max(1.0);
         assert!((fd - &mdot_u).abs().max() < 1e-6 * scale, "Ṁu {mdot_u}");
@@ -78,7 +83,12 @@ fn gravity_is_minus_the_gradient_of_the_potential() {
         let scale = g.abs().max();
         for k in 0..arm.n() {
             let fd = central(&q, k, 1e-6, |q| arm.kinematics(q).gravity_potential());
-            assert!((fd + g[k]).abs() < 1e-6 * scale, "G[{k}] = {} vs {}", g[k], -fd);
+            assert!(
+                (fd + g[k]).abs() < 1e-6 * scale,
+                "G[{k}] = {} vs {}",
+                g[k],
+                -fd
+            );
         }
     }
     // at the initial pose the whole weight acts: Σ_i m_i g along −y
@@ -98,9 +108,16 @@ fn stiffness_of_sine_modes_is_ei_k_pi_over_l_to_the_fourth_l_over_2() {
         for a in 0..3 {
             for b in 0..3 {
                 let kk = f64::from(a as u32 + 1) * std::f64::consts::PI / l;
-                let want = if a == b { ei * kk.powi(4) * l / 2.0 } else { 0.0 };
+                let want = if a == b {
+                    ei * kk.powi(4) * l / 2.0
+                } else {
+                    0.0
+                };
                 let got = k[(o + a, o + b)];
-                assert!((got - want).abs() < 1e-12 * ei, "link {link} K[{a},{b}] = {got} vs {want}");
+                assert!(
+                    (got - want).abs() < 1e-12 * ei,
+                    "link {link} K[{a},{b}] = {got} vs {want}"
+                );
             }
         }
     }

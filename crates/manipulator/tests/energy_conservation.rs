@@ -18,20 +18,44 @@ fn drift(rtol: f64, method: Method) -> (f64, f64, String) {
     scene.add_to(&mut g, "arm").unwrap();
     let mut eqs = StateEquations::new(assign_causality(g).unwrap()).unwrap();
     let outputs = vec![
-        Output { name: "T".into(), probe: eqs.probe("arm_arm.T").unwrap() },
-        Output { name: "V".into(), probe: eqs.probe("arm_c.V").unwrap() },
-        Output { name: "w1".into(), probe: eqs.probe("arm_arm.w1_mid").unwrap() },
+        Output {
+            name: "T".into(),
+            probe: eqs.probe("arm_arm.T").unwrap(),
+        },
+        Output {
+            name: "V".into(),
+            probe: eqs.probe("arm_c.V").unwrap(),
+        },
+        Output {
+            name: "w1".into(),
+            probe: eqs.probe("arm_arm.w1_mid").unwrap(),
+        },
     ];
-    let settings = Settings { t_end: 10.0, dt_out: 0.01, rtol, atol: rtol * 1e-2, method, ..Settings::default() };
+    let settings = Settings {
+        t_end: 10.0,
+        dt_out: 0.01,
+        rtol,
+        atol: rtol * 1e-2,
+        method,
+        ..Settings::default()
+    };
     let x0 = eqs.initial_state();
     let run = simulate(&mut eqs, &x0, &settings, &outputs, vec![]);
     assert!(run.error.is_none(), "{:?}", run.error);
-    let (t, v) = (run.trajectory.column("T").unwrap(), run.trajectory.column("V").unwrap());
+    let (t, v) = (
+        run.trajectory.column("T").unwrap(),
+        run.trajectory.column("V").unwrap(),
+    );
     let e: Vec<f64> = t.iter().zip(&v).map(|(a, b)| a + b).collect();
     // the scale: the kinetic energy the fall reaches
     let scale = t.iter().fold(0.0f64, |m, x| m.max(*x));
     let worst = e.iter().map(|x| (x - e[0]).abs()).fold(0.0, f64::max);
-    let w1 = run.trajectory.column("w1").unwrap().iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let w1 = run
+        .trajectory
+        .column("w1")
+        .unwrap()
+        .iter()
+        .fold(0.0f64, |m, x| m.max(x.abs()));
     (worst / scale, w1, run.stats.to_string())
 }
 

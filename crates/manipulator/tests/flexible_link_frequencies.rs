@@ -30,7 +30,10 @@ fn frequency(t: &[f64], y: &[f64]) -> f64 {
 
 #[test]
 fn modal_frequencies_with_the_joint_held() {
-    let link = Link::beam(L, E, RHO, A, I).unwrap().with_sine_modes(3).unwrap();
+    let link = Link::beam(L, E, RHO, A, I)
+        .unwrap()
+        .with_sine_modes(3)
+        .unwrap();
     let mut scene = ArmScene::new(vec![link], 0.0);
     // a small deflection in each mode; the modes decouple, so each coordinate rings alone
     scene.q0 = vec![0.0, 1e-3, 5e-4, 2.5e-4];
@@ -39,9 +42,18 @@ fn modal_frequencies_with_the_joint_held() {
     scene.add_to(&mut g, "beam").unwrap();
     let mut eqs = StateEquations::new(assign_causality(g).unwrap()).unwrap();
     let outputs: Vec<Output> = (0..4)
-        .map(|k| Output { name: format!("q{k}"), probe: eqs.probe(&format!("beam_arm.q[{k}]")).unwrap() })
+        .map(|k| Output {
+            name: format!("q{k}"),
+            probe: eqs.probe(&format!("beam_arm.q[{k}]")).unwrap(),
+        })
         .collect();
-    let settings = Settings { t_end: 0.2, dt_out: 2e-5, rtol: 1e-10, atol: 1e-12, ..Settings::default() };
+    let settings = Settings {
+        t_end: 0.2,
+        dt_out: 2e-5,
+        rtol: 1e-10,
+        atol: 1e-12,
+        ..Settings::default()
+    };
     let x0 = eqs.initial_state();
     let run = simulate(&mut eqs, &x0, &settings, &outputs, vec![]);
     assert!(run.error.is_none(), "{:?}", run.error);
@@ -61,7 +73,10 @@ fn modal_frequencies_with_the_joint_held() {
             plain(kf),
             w / plain(kf) - 1.0
         );
-        assert!((w / corrected - 1.0).abs() < 1e-6, "mode {k}: {w} vs {corrected}");
+        assert!(
+            (w / corrected - 1.0).abs() < 1e-6,
+            "mode {k}: {w} vs {corrected}"
+        );
         let lowered = 1.0 - corrected / plain(kf);
         assert!((w / plain(kf) - 1.0 + lowered).abs() < 1e-6 && lowered > 0.001 * kf * kf);
     }

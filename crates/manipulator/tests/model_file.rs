@@ -91,7 +91,16 @@ rho6 = "crane_rho.rho6"
 fn the_knuckle_boom_arm_loads_runs_and_switches_its_damping() {
     let mut m = Model::from_text("arm.toml", MODEL, &registry(), &[]).unwrap();
     let g = m.equations.graph();
-    for name in ["crane_arm", "crane_c", "crane_r", "crane_act1", "crane_act2", "crane_lump", "crane_masses", "crane_rho"] {
+    for name in [
+        "crane_arm",
+        "crane_c",
+        "crane_r",
+        "crane_act1",
+        "crane_act2",
+        "crane_lump",
+        "crane_masses",
+        "crane_rho",
+    ] {
         assert!(g.find(name).is_some(), "{name} missing");
     }
     let out = m.run().unwrap();
@@ -111,15 +120,37 @@ fn the_knuckle_boom_arm_loads_runs_and_switches_its_damping() {
 #[test]
 fn mistakes_in_nested_tables_are_reported_with_their_path() {
     for (from, to, expect) in [
-        ("modes = 3 },\n  { type = \"beam\"", "modes = 3, mdoes = 2 },\n  { type = \"beam\"", "unknown key `mdoes`"),
-        ("{ type = \"pendulum\"", "{ type = \"string\"", "links[3].type"),
-        ("{ link = 2, x = \"h3\" } },", "{ link = 4, x = \"h3\" } },", "link 4 does not exist"),
-        ("lumped_model = \"springs\"", "lumped_model = \"spring\"", "lumped_model"),
-        ("q0 = [0.0, \"-2*pi/3\", \"pi/6\"]", "q0 = [0.0, \"-2*pi/3\", \"pi/6\", 0, 0, 0, 0, 0, 0, 0]", "q0"),
+        (
+            "modes = 3 },\n  { type = \"beam\"",
+            "modes = 3, mdoes = 2 },\n  { type = \"beam\"",
+            "unknown key `mdoes`",
+        ),
+        (
+            "{ type = \"pendulum\"",
+            "{ type = \"string\"",
+            "links[3].type",
+        ),
+        (
+            "{ link = 2, x = \"h3\" } },",
+            "{ link = 4, x = \"h3\" } },",
+            "link 4 does not exist",
+        ),
+        (
+            "lumped_model = \"springs\"",
+            "lumped_model = \"spring\"",
+            "lumped_model",
+        ),
+        (
+            "q0 = [0.0, \"-2*pi/3\", \"pi/6\"]",
+            "q0 = [0.0, \"-2*pi/3\", \"pi/6\", 0, 0, 0, 0, 0, 0, 0]",
+            "q0",
+        ),
     ] {
         assert!(MODEL.contains(from), "{from}");
         let text = MODEL.replacen(from, to, 1);
-        let e = Model::from_text("arm.toml", &text, &registry(), &[]).err().unwrap();
+        let e = Model::from_text("arm.toml", &text, &registry(), &[])
+            .err()
+            .unwrap();
         let msg = format!("{e} {}", e.hint.clone().unwrap_or_default());
         assert!(msg.contains(expect), "expected `{expect}` in: {msg}");
         assert!(e.line.is_some(), "{msg}");

@@ -17,8 +17,14 @@ fn build(scene: &ArmScene, forces: &[f64]) -> (StateEquations, Vec<f64>) {
     let mut g = BondGraph::new();
     let ports = scene.add_to(&mut g, "crane").unwrap();
     for (k, f) in forces.iter().enumerate() {
-        let se = g.add(&format!("F{}", k + 1), EffortSource::new(*f)).unwrap();
-        let (_, id, port) = ports.iter().find(|p| p.0 == format!("cyl{}", k + 1)).unwrap().clone();
+        let se = g
+            .add(&format!("F{}", k + 1), EffortSource::new(*f))
+            .unwrap();
+        let (_, id, port) = ports
+            .iter()
+            .find(|p| p.0 == format!("cyl{}", k + 1))
+            .unwrap()
+            .clone();
         g.connect((se, None), (id, port)).unwrap();
     }
     let eqs = StateEquations::new(assign_causality(g).unwrap()).unwrap();
@@ -27,7 +33,11 @@ fn build(scene: &ArmScene, forces: &[f64]) -> (StateEquations, Vec<f64>) {
 }
 
 fn read(eqs: &StateEquations, x: &[f64], name: &str) -> f64 {
-    eqs.read(eqs.probe(name).unwrap_or_else(|| panic!("no {name}")), 0.0, x)
+    eqs.read(
+        eqs.probe(name).unwrap_or_else(|| panic!("no {name}")),
+        0.0,
+        x,
+    )
 }
 
 #[test]
@@ -49,9 +59,18 @@ fn swinging_pendulums_match_the_closed_form() {
     scene.u0 = vec![omega];
     let (eqs, x) = build(&scene, &[]);
     eqs.evaluate(0.0, &x);
-    let (wx, wy) = (-m * l / 2.0 * omega * omega + m * G * theta.sin(), m * G * theta.cos() / 4.0);
-    let (rx, ry) = (read(&eqs, &x, "crane_rho.rho1"), read(&eqs, &x, "crane_rho.rho2"));
-    assert!((rx - wx).abs() < 1e-9 * m * G && (ry - wy).abs() < 1e-9 * m * G, "({rx}, {ry}) vs ({wx}, {wy})");
+    let (wx, wy) = (
+        -m * l / 2.0 * omega * omega + m * G * theta.sin(),
+        m * G * theta.cos() / 4.0,
+    );
+    let (rx, ry) = (
+        read(&eqs, &x, "crane_rho.rho1"),
+        read(&eqs, &x, "crane_rho.rho2"),
+    );
+    assert!(
+        (rx - wx).abs() < 1e-9 * m * G && (ry - wy).abs() < 1e-9 * m * G,
+        "({rx}, {ry}) vs ({wx}, {wy})"
+    );
 }
 
 /// The flexible crane in static equilibrium with the pendulum hanging: cylinder forces and
@@ -74,10 +93,17 @@ fn flexible_equilibrium(q1: f64, q2: f64) -> (Vec<f64>, [f64; 2]) {
             + tau * nalgebra::Vector2::new(z[0], z[1]);
         [0, 1, 3, 4, 5, 6, 7, 8].iter().map(|&i| r[i]).collect()
     };
-    let f = static_forces(&arm, &[q1, q2, -PI / 2.0 - q1 - q2, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+    let f = static_forces(
+        &arm,
+        &[q1, q2, -PI / 2.0 - q1 - q2, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    );
     let mut z0 = vec![f[0], f[1]];
     z0.extend([0.0; 6]);
-    let z = newton(z0, residual, &[1e5, 1e5, 1e-2, 1e-2, 1e-2, 1e-2, 1e-2, 1e-2]);
+    let z = newton(
+        z0,
+        residual,
+        &[1e5, 1e5, 1e-2, 1e-2, 1e-2, 1e-2, 1e-2, 1e-2],
+    );
     (q_of(&z), [z[0], z[1]])
 }
 
@@ -85,7 +111,13 @@ fn flexible_equilibrium(q1: f64, q2: f64) -> (Vec<f64>, [f64; 2]) {
 fn pendulum_hanging_at_rest_carries_its_weight() {
     let (q, f) = flexible_equilibrium(0.2, -2.0);
     eprintln!("equilibrium: F = {f:?}, w1 modal {:?}", &q[3..6]);
-    for model in [LumpedMassModel::Rigid, LumpedMassModel::Springs { stiffness: 1e8, damping: 2e5 }] {
+    for model in [
+        LumpedMassModel::Rigid,
+        LumpedMassModel::Springs {
+            stiffness: 1e8,
+            damping: 2e5,
+        },
+    ] {
         let mut scene = ArmScene::new(crane_links(3), G);
         scene.q0 = q.clone();
         scene.actuators = cylinders();
@@ -95,21 +127,36 @@ fn pendulum_hanging_at_rest_carries_its_weight() {
         if let LumpedMassModel::Springs { stiffness, .. } = model {
             // springs pre-loaded by the weights: k q_y = −m g
             for (m, lm) in lumped_masses().iter().enumerate() {
-                let i = eqs.states().iter().position(|s| s.name == format!("crane_spring.q[{}]", 2 * m + 1)).unwrap();
+                let i = eqs
+                    .states()
+                    .iter()
+                    .position(|s| s.name == format!("crane_spring.q[{}]", 2 * m + 1))
+                    .unwrap();
                 x[i] = -lm.mass * G / stiffness;
             }
         }
         eqs.evaluate(0.0, &x);
-        let udot: Vec<f64> = (0..9).map(|k| read(&eqs, &x, &format!("crane_arm.udot[{k}]"))).collect();
+        let udot: Vec<f64> = (0..9)
+            .map(|k| read(&eqs, &x, &format!("crane_arm.udot[{k}]")))
+            .collect();
         assert!(udot.iter().all(|a| a.abs() < 1e-9), "at rest: u̇ = {udot:?}");
-        let (r5, r6) = (read(&eqs, &x, "crane_rho.rho5"), read(&eqs, &x, "crane_rho.rho6"));
+        let (r5, r6) = (
+            read(&eqs, &x, "crane_rho.rho5"),
+            read(&eqs, &x, "crane_rho.rho6"),
+        );
         eprintln!("{model:?}: ρ5 = {r5}, ρ6 = {r6}");
         assert!((r5 / (-M3 * G) - 1.0).abs() < 1e-9, "ρ5 = {r5}");
         assert!(r6.abs() < 1e-9 * M3 * G, "ρ6 = {r6}");
         if matches!(model, LumpedMassModel::Springs { .. }) {
             for k in 1..=6 {
-                let (a, b) = (read(&eqs, &x, &format!("crane_rho.rho{k}")), read(&eqs, &x, &format!("crane_rho.rho{k}_paper")));
-                assert!((a - b).abs() < 1e-9 * M3 * G, "at rest the paper's variant agrees: ρ{k} {a} vs {b}");
+                let (a, b) = (
+                    read(&eqs, &x, &format!("crane_rho.rho{k}")),
+                    read(&eqs, &x, &format!("crane_rho.rho{k}_paper")),
+                );
+                assert!(
+                    (a - b).abs() < 1e-9 * M3 * G,
+                    "at rest the paper's variant agrees: ρ{k} {a} vs {b}"
+                );
             }
         }
     }
@@ -130,8 +177,14 @@ fn joint_reactions_of_a_static_rigid_pose_balance_gravity_and_the_cylinders() {
     let rho = |j: usize| {
         // frame-j components to frame 0
         let phi: f64 = scene.q0[..=j].iter().sum();
-        let r = Vector2::new(read(&eqs, &x, &format!("crane_rho.rho{}", 2 * j + 1)), read(&eqs, &x, &format!("crane_rho.rho{}", 2 * j + 2)));
-        Vector2::new(phi.cos() * r.x - phi.sin() * r.y, phi.sin() * r.x + phi.cos() * r.y)
+        let r = Vector2::new(
+            read(&eqs, &x, &format!("crane_rho.rho{}", 2 * j + 1)),
+            read(&eqs, &x, &format!("crane_rho.rho{}", 2 * j + 2)),
+        );
+        Vector2::new(
+            phi.cos() * r.x - phi.sin() * r.y,
+            phi.sin() * r.x + phi.cos() * r.y,
+        )
     };
     let pose = arm.pose(&scene.q0);
     let acts = cylinders();

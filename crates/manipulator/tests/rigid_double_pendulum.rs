@@ -20,10 +20,24 @@ const J2: f64 = 0.02;
 const PM2: f64 = 1.1;
 
 fn links() -> Vec<Link> {
-    let pm = |x, mass| PointMass { x, mass, inertia: 0.0 };
+    let pm = |x, mass| PointMass {
+        x,
+        mass,
+        inertia: 0.0,
+    };
     vec![
-        Link::rigid(L1, MU1).unwrap().with_rotary_inertia(J1).unwrap().with_point_mass(pm(A1, PM1)).unwrap(),
-        Link::rigid(L2, MU2).unwrap().with_rotary_inertia(J2).unwrap().with_point_mass(pm(L2, PM2)).unwrap(),
+        Link::rigid(L1, MU1)
+            .unwrap()
+            .with_rotary_inertia(J1)
+            .unwrap()
+            .with_point_mass(pm(A1, PM1))
+            .unwrap(),
+        Link::rigid(L2, MU2)
+            .unwrap()
+            .with_rotary_inertia(J2)
+            .unwrap()
+            .with_point_mass(pm(L2, PM2))
+            .unwrap(),
     ]
 }
 
@@ -63,7 +77,12 @@ fn mass_matrix_and_accelerations_match_the_closed_form() {
         let (m_exact, acc_exact) = closed_form(q, u);
         let m = arm.kinematics(&q).mass_matrix();
         for (a, b) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
-            assert!((m[(a, b)] - m_exact[(a, b)]).abs() < 1e-12, "M[{a},{b}] = {} vs {}", m[(a, b)], m_exact[(a, b)]);
+            assert!(
+                (m[(a, b)] - m_exact[(a, b)]).abs() < 1e-12,
+                "M[{a},{b}] = {} vs {}",
+                m[(a, b)],
+                m_exact[(a, b)]
+            );
         }
         let mut g = BondGraph::new();
         scene.add_to(&mut g, "pend").unwrap();
@@ -72,13 +91,20 @@ fn mass_matrix_and_accelerations_match_the_closed_form() {
         eqs.evaluate(0.0, &x0);
         for k in 0..2 {
             let udot = eqs.read(eqs.probe(&format!("pend_arm.udot[{k}]")).unwrap(), 0.0, &x0);
-            assert!((udot - acc_exact[k]).abs() < 1e-12, "q {q:?} u {u:?}: u̇{k} = {udot} vs {}", acc_exact[k]);
+            assert!(
+                (udot - acc_exact[k]).abs() < 1e-12,
+                "q {q:?} u {u:?}: u̇{k} = {udot} vs {}",
+                acc_exact[k]
+            );
             let u_out = eqs.read(eqs.probe(&format!("pend_arm.u[{k}]")).unwrap(), 0.0, &x0);
             assert!((u_out - u[k]).abs() < 1e-13);
         }
         // and the momentum rate ṗ = e + E integrates to the same accelerations
         let mut dx = vec![0.0; x0.len()];
         eqs.rhs(0.0, &x0, &mut dx);
-        assert!((dx[2] - u[0]).abs() < 1e-13 && (dx[3] - u[1]).abs() < 1e-13, "q̇ = u");
+        assert!(
+            (dx[2] - u[0]).abs() < 1e-13 && (dx[3] - u[1]).abs() < 1e-13,
+            "q̇ = u"
+        );
     }
 }

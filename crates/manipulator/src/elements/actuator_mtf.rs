@@ -12,12 +12,17 @@
 use std::cell::RefCell;
 use std::sync::Arc;
 
-use bondgraph::{CausalRule, Element, Io, ParamError, PortCausality, PortSpec, Ports, SignalSpec, Slot, Stage};
+use bondgraph::{
+    CausalRule, Element, Io, ParamError, PortCausality, PortSpec, Ports, SignalSpec, Slot, Stage,
+};
 use nalgebra::DMatrix;
 
 use super::mtf_law;
 use crate::actuator::LinearActuator;
 use crate::arm::PlanarArm;
+
+/// τ_b and the lengths at one configuration q.
+type Modulus = (Vec<f64>, DMatrix<f64>, Vec<f64>);
 
 /// The actuator MTF of a [`PlanarArm`].
 #[derive(Debug)]
@@ -26,7 +31,7 @@ pub struct ActuatorTransformer {
     acts: Vec<LinearActuator>,
     q_signal: String,
     first: usize,
-    cache: RefCell<Option<(Vec<f64>, DMatrix<f64>, Vec<f64>)>>,
+    cache: RefCell<Option<Modulus>>,
 }
 
 impl ActuatorTransformer {

@@ -8,9 +8,7 @@
 
 use std::sync::Arc;
 
-use bondgraph::{
-    CausalRule, Element, Io, PortCausality, PortSpec, Ports, SignalSpec, Slot, Stage,
-};
+use bondgraph::{CausalRule, Element, Io, PortCausality, PortSpec, Ports, SignalSpec, Slot, Stage};
 use nalgebra::{DMatrix, DVector};
 
 use crate::arm::PlanarArm;

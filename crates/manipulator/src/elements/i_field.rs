@@ -68,7 +68,11 @@ impl ArmInertia {
             if v.len() != n {
                 return Err(ParamError::Shape {
                     param: name.into(),
-                    message: format!("needs {n} values ({}), got {}", arm.coordinate_names().join(", "), v.len()),
+                    message: format!(
+                        "needs {n} values ({}), got {}",
+                        arm.coordinate_names().join(", "),
+                        v.len()
+                    ),
                 });
             }
             for &x in v {
@@ -82,13 +86,20 @@ impl ArmInertia {
                 message: "the mass matrix is singular: every coordinate needs inertia (a massless link without a point mass?)".into(),
             });
         }
-        let p0 = (&m * DVector::from_column_slice(&u0)).iter().copied().collect();
+        let p0 = (&m * DVector::from_column_slice(&u0))
+            .iter()
+            .copied()
+            .collect();
         let p_nominal = (0..n).map(|k| m[(k, k)].max(f64::MIN_POSITIVE)).collect();
         let mid = arm
             .links()
             .iter()
             .enumerate()
-            .map(|(i, l)| (!l.is_rigid()).then(|| arm.station(i, l.length() / 2.0).ok()).flatten())
+            .map(|(i, l)| {
+                (!l.is_rigid())
+                    .then(|| arm.station(i, l.length() / 2.0).ok())
+                    .flatten()
+            })
             .collect();
         Ok(Self {
             arm,
@@ -159,8 +170,14 @@ impl Element for ArmInertia {
     fn signal_outputs(&self) -> Vec<SignalSpec> {
         let n = self.arm.n();
         let mut out = vec![
-            SignalSpec { name: "u".into(), dim: n },
-            SignalSpec { name: "udot".into(), dim: n },
+            SignalSpec {
+                name: "u".into(),
+                dim: n,
+            },
+            SignalSpec {
+                name: "udot".into(),
+                dim: n,
+            },
             SignalSpec::scalar("T"),
         ];
         for i in 1..=self.arm.n_links() {

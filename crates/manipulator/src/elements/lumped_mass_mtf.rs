@@ -10,7 +10,9 @@
 use std::cell::RefCell;
 use std::sync::Arc;
 
-use bondgraph::{CausalRule, Element, Io, ParamError, PortCausality, PortSpec, Ports, SignalSpec, Stage};
+use bondgraph::{
+    CausalRule, Element, Io, ParamError, PortCausality, PortSpec, Ports, SignalSpec, Stage,
+};
 use nalgebra::DMatrix;
 
 use super::mtf_law;

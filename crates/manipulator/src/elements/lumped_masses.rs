@@ -1,7 +1,9 @@
 //! The lumped cylinder masses (eq. 75): an I-field `ṗ = e`, `f_in = M_c⁻¹ p` with
 //! `M_c = diag(m₁ I₂, m₂ I₂, …)`, velocities in frame 0 (x then y per mass).
 
-use bondgraph::{CausalRule, Element, Io, ParamError, PortCausality, PortSpec, Ports, Stage, StateSpec};
+use bondgraph::{
+    CausalRule, Element, Io, ParamError, PortCausality, PortSpec, Ports, Stage, StateSpec,
+};
 
 use super::component_names;
 
@@ -18,13 +20,22 @@ impl LumpedMasses {
         if masses.is_empty() || v0.len() != 2 * masses.len() {
             return Err(ParamError::Shape {
                 param: "lumped_masses".into(),
-                message: format!("{} masses need {} initial velocities, got {}", masses.len(), 2 * masses.len(), v0.len()),
+                message: format!(
+                    "{} masses need {} initial velocities, got {}",
+                    masses.len(),
+                    2 * masses.len(),
+                    v0.len()
+                ),
             });
         }
         for &m in &masses {
             ParamError::positive("lumped mass", m)?;
         }
-        let p0 = v0.iter().enumerate().map(|(k, v)| masses[k / 2] * v).collect();
+        let p0 = v0
+            .iter()
+            .enumerate()
+            .map(|(k, v)| masses[k / 2] * v)
+            .collect();
         Ok(Self { masses, p0 })
     }
 }
@@ -62,6 +73,11 @@ impl Element for LumpedMasses {
         }
     }
     fn stored_energy(&self, x: &[f64]) -> Option<f64> {
-        Some(x.iter().enumerate().map(|(k, p)| p * p / (2.0 * self.masses[k / 2])).sum())
+        Some(
+            x.iter()
+                .enumerate()
+                .map(|(k, p)| p * p / (2.0 * self.masses[k / 2]))
+                .sum(),
+        )
     }
 }

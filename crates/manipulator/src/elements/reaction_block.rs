@@ -74,10 +74,15 @@ impl ArmReactions {
             .collect::<Result<_, ParamError>>()?;
         let springs = springs
             .iter()
-            .map(|m| Ok((station(&arm, &m.pin)?.ok_or_else(|| ParamError::Shape {
-                param: "lumped_masses".into(),
-                message: "a lumped mass must sit on a link".into(),
-            })?, m.mass)))
+            .map(|m| {
+                Ok((
+                    station(&arm, &m.pin)?.ok_or_else(|| ParamError::Shape {
+                        param: "lumped_masses".into(),
+                        message: "a lumped mass must sit on a link".into(),
+                    })?,
+                    m.mass,
+                ))
+            })
             .collect::<Result<_, ParamError>>()?;
         Ok(Self {
             arm,
@@ -108,7 +113,11 @@ impl Element for ArmReactions {
             name: name.to_owned(),
             dim,
         };
-        let mut s = vec![v(&self.inputs.q, n), v(&self.inputs.u, n), v(&self.inputs.udot, n)];
+        let mut s = vec![
+            v(&self.inputs.q, n),
+            v(&self.inputs.u, n),
+            v(&self.inputs.udot, n),
+        ];
         s.extend(self.inputs.forces.iter().map(|f| v(f, 1)));
         if let Some(p) = &self.inputs.pin_forces {
             s.push(v(p, 2 * self.springs.len()));
@@ -116,25 +125,36 @@ impl Element for ArmReactions {
         s
     }
     fn signal_outputs(&self) -> Vec<SignalSpec> {
-        let mut out: Vec<SignalSpec> =
-            (1..=self.n_rho()).map(|k| SignalSpec::scalar(&format!("rho{k}"))).collect();
+        let mut out: Vec<SignalSpec> = (1..=self.n_rho())
+            .map(|k| SignalSpec::scalar(&format!("rho{k}")))
+            .collect();
         if !self.springs.is_empty() {
             out.extend((1..=self.n_rho()).map(|k| SignalSpec::scalar(&format!("rho{k}_paper"))));
         }
         out
     }
     fn eval(&self, _: usize, io: &mut Io<'_>) {
-        let (q, u, udot) = (io.input(0).to_vec(), io.input(1).to_vec(), io.input(2).to_vec());
+        let (q, u, udot) = (
+            io.input(0).to_vec(),
+            io.input(1).to_vec(),
+            io.input(2).to_vec(),
+        );
         let kin = self.arm.kinematics(&q);
         let pose = kin.pose();
         let mut loads = Vec::new();
         for (c, (sa, sb, act)) in self.acts.iter().enumerate() {
             let f = io.u(3 + c) * act.direction(pose);
             if let Some(s) = sb {
-                loads.push(PointLoad { station: s.clone(), force: f });
+                loads.push(PointLoad {
+                    station: s.clone(),
+                    force: f,
+                });
             }
             if let Some(s) = sa {
-                loads.push(PointLoad { station: s.clone(), force: -f });
+                loads.push(PointLoad {
+                    station: s.clone(),
+                    force: -f,
+                });
             }
         }
         let n_act_loads = loads.len();

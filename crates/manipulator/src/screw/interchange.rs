@@ -29,7 +29,8 @@ pub fn swap(s: &Screw) -> Screw {
 /// The power `tᵀ Π w` of wrench `w` on twist `t`.
 #[must_use]
 pub fn power(t: &Screw, w: &Screw) -> f64 {
-    t.fixed_rows::<3>(0).dot(&w.fixed_rows::<3>(3)) + t.fixed_rows::<3>(3).dot(&w.fixed_rows::<3>(0))
+    t.fixed_rows::<3>(0).dot(&w.fixed_rows::<3>(3))
+        + t.fixed_rows::<3>(3).dot(&w.fixed_rows::<3>(0))
 }
 
 #[cfg(test)]

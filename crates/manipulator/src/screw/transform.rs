@@ -64,7 +64,8 @@ impl ReferenceTransform {
     #[must_use]
     pub fn matrix(&self) -> Matrix6<f64> {
         let mut u = Matrix6::identity();
-        u.fixed_view_mut::<3, 3>(3, 0).copy_from(&self.p.cross_matrix());
+        u.fixed_view_mut::<3, 3>(3, 0)
+            .copy_from(&self.p.cross_matrix());
         u
     }
     /// `U_{j,k}^j = (U_{k,j}^j)⁻¹`: the reference point moved back.

@@ -29,7 +29,10 @@ pub fn crane(modes: u32) -> PlanarArm {
 pub fn cylinders() -> Vec<LinearActuator> {
     let b3 = PI / 3.0;
     vec![
-        LinearActuator::new(Pin::ground(3.0 * b3.cos(), -3.0 * b3.sin()), Pin::on_link(0, 4.0)),
+        LinearActuator::new(
+            Pin::ground(3.0 * b3.cos(), -3.0 * b3.sin()),
+            Pin::on_link(0, 4.0),
+        ),
         LinearActuator::new(Pin::on_link(0, 6.0), Pin::on_link(1, 3.0)),
     ]
 }
@@ -37,9 +40,18 @@ pub fn cylinders() -> Vec<LinearActuator> {
 /// Piston 1 at H1,1, barrel 2 at H1,2, piston 2 at H2,1.
 pub fn lumped_masses() -> Vec<LumpedMass> {
     vec![
-        LumpedMass { pin: Pin::on_link(0, 4.0), mass: M_P },
-        LumpedMass { pin: Pin::on_link(0, 6.0), mass: M_B },
-        LumpedMass { pin: Pin::on_link(1, 3.0), mass: M_P },
+        LumpedMass {
+            pin: Pin::on_link(0, 4.0),
+            mass: M_P,
+        },
+        LumpedMass {
+            pin: Pin::on_link(0, 6.0),
+            mass: M_B,
+        },
+        LumpedMass {
+            pin: Pin::on_link(1, 3.0),
+            mass: M_P,
+        },
     ]
 }
 
@@ -65,7 +77,13 @@ impl Rng {
     /// A random configuration: angles in [−π, π), modal coordinates up to ±`amp` m.
     pub fn q(&mut self, arm: &PlanarArm, amp: f64) -> Vec<f64> {
         (0..arm.n())
-            .map(|k| if k < arm.n_links() { self.uniform(-PI, PI) } else { self.uniform(-amp, amp) })
+            .map(|k| {
+                if k < arm.n_links() {
+                    self.uniform(-PI, PI)
+                } else {
+                    self.uniform(-amp, amp)
+                }
+            })
             .collect()
     }
     pub fn vec(&mut self, n: usize, scale: f64) -> Vec<f64> {
