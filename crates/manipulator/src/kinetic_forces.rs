@@ -113,7 +113,7 @@ impl ArmKinematics<'_> {
                 mdot_u[j] += p.mass * z_cross(&d_dot).dot(&pv.v);
             }
             // Pᵀ D Ṗu
-            for (c, col) in p.projection.columns() {
+            for (c, col) in &p.projection.cols {
                 mdot_u[*c] += p.mass * (col[3] * pv.a_v.x + col[4] * pv.a_v.y);
             }
         }

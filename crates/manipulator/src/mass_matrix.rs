@@ -31,11 +31,24 @@ impl ArmKinematics<'_> {
         let n = self.arm().n();
         let mut m = DMatrix::zeros(n, n);
         for p in self.points() {
-            let cols = p.projection.columns();
+            let cols = &p.projection.cols;
+            let (j, mass) = (p.inertia, p.mass);
             for (a, ca) in cols {
-                let dca = inertia_times(&p, ca);
+                let d = [
+                    j * ca[0],
+                    j * ca[1],
+                    j * ca[2],
+                    mass * ca[3],
+                    mass * ca[4],
+                    mass * ca[5],
+                ];
                 for (b, cb) in cols {
-                    m[(*a, *b)] += dca.dot(cb);
+                    m[(*a, *b)] += d[0] * cb[0]
+                        + d[1] * cb[1]
+                        + d[2] * cb[2]
+                        + d[3] * cb[3]
+                        + d[4] * cb[4]
+                        + d[5] * cb[5];
                 }
             }
         }

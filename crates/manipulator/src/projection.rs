@@ -26,7 +26,7 @@ pub struct Projection {
     n: usize,
     link: usize,
     /// (index in u, column): joints 0..=link first, then the link's modes.
-    columns: Vec<(usize, Screw)>,
+    pub(crate) cols: Vec<(usize, [f64; 6])>,
     /// Moment arms `d_j = R_0^i (r − o_j)` of the station about joints j = 0..=link, in the
     /// coordinates of the link's frame (used for ∂P/∂q).
     arms: Vec<Vector2<f64>>,
@@ -47,17 +47,17 @@ impl Projection {
             let pj = pose.to_frame(j, &(pose.origin(j) - r));
             let (c, sn) = pose.relative_rotation(j, i);
             let v = ScrewTransform::new(rot_z_cs(c, sn), Vector3::new(pj.x, pj.y, 0.0));
-            columns.push((j, v.apply(&line)));
+            columns.push((j, v.apply(&line).into()));
             arms.push(pose.to_frame(i, &(r - pose.origin(j))));
         }
         let o = arm.modal_offset(i);
         for (k, (psi, theta)) in s.psi.iter().zip(&s.theta).enumerate() {
-            columns.push((o + k, line_z() * *theta + screw_n_y() * *psi));
+            columns.push((o + k, (line_z() * *theta + screw_n_y() * *psi).into()));
         }
         Self {
             n: arm.n(),
             link: i,
-            columns,
+            cols: columns,
             arms,
         }
     }
@@ -67,10 +67,10 @@ impl Projection {
     pub fn in_base_frame(&self, pose: &Pose<'_>) -> Self {
         let rb = pose.screw_to_base(self.link);
         Self {
-            columns: self
-                .columns
+            cols: self
+                .cols
                 .iter()
-                .map(|(k, c)| (*k, rb.apply(c)))
+                .map(|(k, c)| (*k, rb.apply(&Screw::from(*c)).into()))
                 .collect(),
             ..self.clone()
         }
@@ -82,9 +82,8 @@ impl Projection {
         self.link
     }
     /// Non-zero columns with their index in u.
-    #[must_use]
-    pub fn columns(&self) -> &[(usize, Screw)] {
-        &self.columns
+    pub fn columns(&self) -> impl Iterator<Item = (usize, Screw)> + '_ {
+        self.cols.iter().map(|(k, c)| (*k, Screw::from(*c)))
     }
     /// The moment arms `d_j` (frame of the link) about joints 0..=link.
     #[must_use]
@@ -95,25 +94,30 @@ impl Projection {
     #[must_use]
     pub fn twist(&self, u: &[f64]) -> Screw {
         let mut t = [0.0; 6];
-        for (k, c) in &self.columns {
-            for (r, tr) in t.iter_mut().enumerate() {
-                *tr += c[r] * u[*k];
-            }
+        for (k, c) in &self.cols {
+            let uk = u[*k];
+            t[0] += c[0] * uk;
+            t[1] += c[1] * uk;
+            t[2] += c[2] * uk;
+            t[3] += c[3] * uk;
+            t[4] += c[4] * uk;
+            t[5] += c[5] * uk;
         }
         Screw::from(t)
     }
     /// `out += Pᵀ w`.
     pub fn add_transpose_times(&self, w: &Screw, out: &mut [f64]) {
-        for (k, c) in &self.columns {
-            out[*k] += (0..6).map(|r| c[r] * w[r]).sum::<f64>();
+        for (k, c) in &self.cols {
+            out[*k] +=
+                c[0] * w[0] + c[1] * w[1] + c[2] * w[2] + c[3] * w[3] + c[4] * w[4] + c[5] * w[5];
         }
     }
     /// The dense 6×n matrix.
     #[must_use]
     pub fn matrix(&self) -> DMatrix<f64> {
         let mut m = DMatrix::zeros(6, self.n);
-        for (k, c) in &self.columns {
-            m.column_mut(*k).copy_from(c);
+        for (k, c) in self.columns() {
+            m.column_mut(k).copy_from(&c);
         }
         m
     }
@@ -121,7 +125,7 @@ impl Projection {
     #[must_use]
     pub fn velocity_jacobian(&self) -> DMatrix<f64> {
         let mut j = DMatrix::zeros(2, self.n);
-        for (k, c) in &self.columns {
+        for (k, c) in &self.cols {
             j[(0, *k)] = c[3];
             j[(1, *k)] = c[4];
         }
@@ -178,7 +182,7 @@ mod tests {
         let s = arm.station(1, 5.0).unwrap();
         let p = Projection::at(&pose, &s);
         for (j, d) in p.arms().iter().enumerate() {
-            let c = p.columns()[j].1;
+            let c = p.cols[j].1;
             assert!((c[2] - 1.0).abs() < 1e-15);
             assert!((c[3] + d.y).abs() < 1e-12 && (c[4] - d.x).abs() < 1e-12);
         }
