@@ -59,12 +59,13 @@ fn drift(rtol: f64, method: Method) -> (f64, f64, String) {
     (worst / scale, w1, run.stats.to_string())
 }
 
+/// Measured (BDF, atol = rtol/100): drift 3.7e-8 at rtol 1e-6, 8.7e-9 at rtol 1e-8 (that
+/// one takes twice as long, so only rtol 1e-6 runs here).
 #[test]
 fn energy_of_the_free_flexible_arm_is_conserved() {
-    for rtol in [1e-6, 1e-8] {
-        let (rel, w1, stats) = drift(rtol, Method::Bdf);
-        eprintln!("rtol {rtol:e}: max |ΔE|/max T = {rel:.2e} over 10 s (max |w1_mid| = {w1:.3} m); {stats}");
-        assert!(rel < 100.0 * rtol, "drift {rel} at rtol {rtol}");
-        assert!(w1 > 1e-3, "the links do bend");
-    }
+    let rtol = 1e-6;
+    let (rel, w1, stats) = drift(rtol, Method::Bdf);
+    eprintln!("rtol {rtol:e}: max |ΔE|/max T = {rel:.2e} over 10 s (max |w1_mid| = {w1:.3} m); {stats}");
+    assert!(rel < rtol, "drift {rel} at rtol {rtol}");
+    assert!(w1 > 1e-3, "the links do bend");
 }
