@@ -245,6 +245,14 @@ pub enum SimulationError {
     /// Settings are invalid.
     #[error("invalid simulation settings: {0}")]
     Settings(String),
+    /// One setting is invalid.
+    #[error("invalid simulation setting `{setting}`: {message}")]
+    InvalidSetting {
+        /// The setting (`t_end`, `dt_out`, `rtol`, `atol`).
+        setting: &'static str,
+        /// What is wrong.
+        message: String,
+    },
     /// The solver failed.
     #[error("solver failed at t = {t:.9} s: {message}{culprit}")]
     Solver {

@@ -108,30 +108,34 @@ impl Default for Settings {
 impl Settings {
     /// Check the settings make sense.
     pub fn validate(&self) -> Result<(), SimulationError> {
-        let bad = |m: String| Err(SimulationError::Settings(m));
+        let bad =
+            |setting, message: String| Err(SimulationError::InvalidSetting { setting, message });
         if !self.t_start.is_finite() || !self.t_end.is_finite() || self.t_end <= self.t_start {
-            return bad(format!(
-                "need finite t_start < t_end, got t_start = {}, t_end = {}",
-                self.t_start, self.t_end
-            ));
+            return bad(
+                "t_end",
+                format!(
+                    "need finite t_start < t_end, got t_start = {}, t_end = {}",
+                    self.t_start, self.t_end
+                ),
+            );
         }
         if !(self.dt_out.is_finite() && self.dt_out > 0.0) {
-            return bad(format!(
-                "dt_out must be finite and > 0, got {}",
-                self.dt_out
-            ));
+            return bad(
+                "dt_out",
+                format!("must be finite and > 0, got {}", self.dt_out),
+            );
         }
         if (self.t_end - self.t_start) / self.dt_out > 1e8 {
-            return bad(format!(
-                "dt_out = {} gives more than 1e8 output rows",
-                self.dt_out
-            ));
+            return bad(
+                "dt_out",
+                format!("{} gives more than 1e8 output rows", self.dt_out),
+            );
         }
         if !(self.rtol.is_finite() && self.rtol > 0.0 && self.rtol < 1.0) {
-            return bad(format!("rtol must be in (0, 1), got {}", self.rtol));
+            return bad("rtol", format!("must be in (0, 1), got {}", self.rtol));
         }
         if !(self.atol.is_finite() && self.atol > 0.0) {
-            return bad(format!("atol must be finite and > 0, got {}", self.atol));
+            return bad("atol", format!("must be finite and > 0, got {}", self.atol));
         }
         Ok(())
     }

@@ -237,13 +237,20 @@ impl Compiled {
     pub fn eval(&self, inputs: &[f64]) -> f64 {
         eval_node(&self.0, inputs)
     }
-    /// The value if the expression has no inputs.
+    /// The value if the expression reads no inputs (it may still be NaN or infinite).
     #[must_use]
     pub fn constant(&self) -> Option<f64> {
-        match &self.0 {
-            Node::Num(v) => Some(*v),
-            _ => None,
-        }
+        (!reads_inputs(&self.0)).then(|| eval_node(&self.0, &[]))
+    }
+}
+
+fn reads_inputs(n: &Node) -> bool {
+    match n {
+        Node::Num(_) => false,
+        Node::Input(_) => true,
+        Node::Neg(a) => reads_inputs(a),
+        Node::Bin(_, a, b) => reads_inputs(a) || reads_inputs(b),
+        Node::Call(_, args) => args.iter().any(reads_inputs),
     }
 }
 

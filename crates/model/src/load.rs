@@ -64,9 +64,9 @@ struct EventSpec {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct CheckSpec {
-    value: String,
-    expected: String,
-    tol: f64,
+    value: Spanned<String>,
+    expected: Spanned<String>,
+    tol: Spanned<f64>,
 }
 
 /// A check of the results: at every output row, |value − expected| ≤ tol, where `value` and
@@ -467,7 +467,15 @@ struct Parsed {
 
 fn syntax(file: &str, text: &str, e: &toml::de::Error) -> ModelError {
     let pos = e.span().map(|s| line_col(text, s.start));
-    ModelError::new(ErrorKind::Syntax, file, e.message().to_owned())
+    let mut message = e.message().trim().to_owned();
+    if let Some(s) = e.span() {
+        // name the key or value the parser stopped at
+        let at = text.get(s.clone()).unwrap_or("").trim();
+        if !at.is_empty() && at.len() < 60 && !at.contains('\n') && !message.contains(at) {
+            message = format!("{message}: `{at}`");
+        }
+    }
+    ModelError::new(ErrorKind::Syntax, file, message)
         .at(pos)
         .hint("a model has the sections title, description, [parameters], [elements], [bonds], [simulation], [initial], [[events]], [outputs], [[check]]")
 }
@@ -494,6 +502,11 @@ fn parse(
 ) -> Result<Parsed, ModelError> {
     let text = crate::overrides::apply(file, text, overrides)?;
     let spec: FileSpec = toml::from_str(&text).map_err(|e| syntax(file, &text, &e))?;
+    if spec.elements.is_empty() {
+        return Err(ModelError::new(ErrorKind::Syntax, file, "the model has no elements")
+            .at(Some((1, 1)))
+            .hint("add an [elements] section, e.g. `mass = { kind = \"I\", m = 1.0 }`; see docs/model-format.md"));
+    }
     let mut source = Source {
         file: file.to_owned(),
         text: text.clone(),
@@ -700,7 +713,18 @@ fn build_graph(p: &mut Parsed) -> Result<BondGraph, ModelError> {
                 ),
                 _ => "each port takes exactly one bond".into(),
             };
-            err(ErrorKind::Graph, e.to_string()).hint(hint)
+            let text = e.to_string();
+            let (msg, core_hint) = text.split_once("; hint: ").unwrap_or((text.as_str(), ""));
+            let hint = if core_hint.is_empty() {
+                hint
+            } else {
+                format!("{core_hint}; {hint}")
+            };
+            let m = err(ErrorKind::Graph, msg.to_owned()).hint(hint);
+            match graph_element(&e) {
+                Some(el) => m.element(el),
+                None => m,
+            }
         })?;
     }
     Ok(g)
@@ -738,7 +762,12 @@ fn core_error(source: &Source, e: bondgraph::Error) -> ModelError {
         bondgraph::Error::Param(_) => (ErrorKind::BadParameter, None),
         _ => (ErrorKind::Settings, None),
     };
-    let mut m = ModelError::new(kind, &source.file, e.to_string());
+    // The core's messages end in "; hint: …": keep the hint apart.
+    let text = e.to_string();
+    let mut m = match text.split_once("; hint: ") {
+        Some((msg, hint)) => ModelError::new(kind, &source.file, msg).hint(hint),
+        None => ModelError::new(kind, &source.file, text),
+    };
     if let Some(el) = element {
         m = m.at(source.element_pos(&el)).element(&el);
     }
@@ -913,8 +942,23 @@ fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
         })?;
     }
     if let Err(e) = settings.validate() {
-        let span = sim.t_end.as_ref().map(Spanned::span);
-        return Err(source.err(ErrorKind::Settings, span.as_ref(), e.to_string()));
+        let span_of = |v: &Option<Spanned<f64>>| v.as_ref().map(Spanned::span);
+        let span = match &e {
+            bondgraph::SimulationError::InvalidSetting { setting, .. } => match *setting {
+                "dt_out" => span_of(&sim.dt_out),
+                "rtol" => span_of(&sim.rtol),
+                "atol" => span_of(&sim.atol),
+                _ => span_of(&sim.t_end).or_else(|| span_of(&sim.t_start)),
+            },
+            _ => None,
+        };
+        return Err(source
+            .err(
+                ErrorKind::Settings,
+                span.as_ref(),
+                format!("[simulation] {e}"),
+            )
+            .hint("t_start < t_end, dt_out > 0, 0 < rtol < 1, atol > 0"));
     }
     // outputs
     let mut outputs = Vec::new();
@@ -945,12 +989,13 @@ fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
     let mut checks = Vec::new();
     for c in &spec.check {
         let cs = c.get_ref();
-        let parse_checked = |what: &str, text: &str| -> Result<Expr, ModelError> {
-            let e = Expr::parse(text).map_err(|e| {
+        let parse_checked = |what: &str, text: &Spanned<String>| -> Result<Expr, ModelError> {
+            let span = text.span();
+            let e = Expr::parse(text.get_ref()).map_err(|e| {
                 source.err(
                     ErrorKind::Settings,
-                    Some(&c.span()),
-                    format!("[[check]] {what} = \"{text}\": {e}"),
+                    Some(&span),
+                    format!("[[check]] {what} = \"{}\": {e}", text.get_ref()),
                 )
             })?;
             for n in e.names() {
@@ -960,7 +1005,7 @@ fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
                     && !outputs.iter().any(|o| o.name == n)
                 {
                     return Err(source
-                        .err(ErrorKind::Settings, Some(&c.span()), format!("[[check]] {what} uses `{n}`, which is neither `t`, a parameter nor an output column"))
+                        .err(ErrorKind::Settings, Some(&span), format!("[[check]] {what} uses `{n}`, which is neither `t`, a parameter nor an output column"))
                         .hint("name output columns in [outputs] with plain names (letters, digits, _) to use them in checks"));
                 }
             }
@@ -968,17 +1013,18 @@ fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
         };
         let value_expr = parse_checked("value", &cs.value)?;
         let expected_expr = parse_checked("expected", &cs.expected)?;
-        if !(cs.tol.is_finite() && cs.tol >= 0.0) {
+        let tol = *cs.tol.get_ref();
+        if !(tol.is_finite() && tol >= 0.0) {
             return Err(source.err(
                 ErrorKind::Settings,
-                Some(&c.span()),
-                format!("[[check]] tol must be finite and >= 0, got {}", cs.tol),
+                Some(&cs.tol.span()),
+                format!("[[check]] tol must be finite and >= 0, got {tol}"),
             ));
         }
         checks.push(Check {
-            value: cs.value.clone(),
-            expected: cs.expected.clone(),
-            tol: cs.tol,
+            value: cs.value.get_ref().clone(),
+            expected: cs.expected.get_ref().clone(),
+            tol,
             value_expr,
             expected_expr,
         });

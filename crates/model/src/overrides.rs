@@ -56,7 +56,10 @@ fn set_path(item: &mut Item, path: &[&str], i: usize, value: Value) -> Result<()
             ));
         }
         if !exists && path[0] == "elements" && path.len() == 2 {
-            return Err((format!("the model has no element `{seg}`"), None));
+            return Err((
+                format!("the model has no element `{seg}`"),
+                Some(known_keys(table)),
+            ));
         }
         let mut value = value;
         if let Some(old) = table.get(seg).and_then(Item::as_value) {
@@ -68,7 +71,10 @@ fn set_path(item: &mut Item, path: &[&str], i: usize, value: Value) -> Result<()
     }
     if !exists {
         if path[0] == "elements" && i == 1 {
-            return Err((format!("the model has no element `{seg}`"), None));
+            return Err((
+                format!("the model has no element `{seg}`"),
+                Some(known_keys(table)),
+            ));
         }
         table.insert(seg, Item::Table(toml_edit::Table::new()));
     }
@@ -76,6 +82,11 @@ fn set_path(item: &mut Item, path: &[&str], i: usize, value: Value) -> Result<()
         .get_mut(seg)
         .ok_or_else(|| (format!("no `{seg}`"), None))?;
     set_path(next, path, i + 1, value)
+}
+
+fn known_keys(table: &dyn toml_edit::TableLike) -> String {
+    let keys: Vec<&str> = table.iter().map(|(k, _)| k).collect();
+    format!("it has: {}", keys.join(", "))
 }
 
 fn parse_value(s: &str) -> Value {

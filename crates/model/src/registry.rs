@@ -128,6 +128,33 @@ impl Registry {
     }
 }
 
+/// Whether `a` looks like a misspelling of `b`: same ignoring case, one a prefix of the
+/// other, or at most one edit apart.
+pub(crate) fn similar(a: &str, b: &str) -> bool {
+    if a.eq_ignore_ascii_case(b)
+        || (a.len() > 1 && b.starts_with(a))
+        || (b.len() > 1 && a.starts_with(b))
+    {
+        return true;
+    }
+    let (a, b): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
+    if a.len().abs_diff(b.len()) > 1 {
+        return false;
+    }
+    // Levenshtein distance ≤ 1
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.iter().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, cb) in b.iter().enumerate() {
+            cur[j + 1] = (prev[j] + usize::from(ca != cb))
+                .min(prev[j + 1] + 1)
+                .min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()] <= 1
+}
+
 /// A parameter value as written in the file, with its byte span.
 #[derive(Clone, Debug)]
 pub struct RawValue {
@@ -207,12 +234,31 @@ impl ElementSpec<'_> {
     }
 
     fn missing(&self, key: &str, what: &str) -> ModelError {
-        self.error(
-            key,
-            ErrorKind::MissingParameter,
-            format!("({}) needs parameter `{key}` ({what})", self.kind),
-        )
-        .hint(format!("add `{key} = …` to element `{}`", self.name))
+        // A key nobody asked for that looks like this one is probably a misspelling of it.
+        let asked = self.asked.borrow();
+        let typo = self
+            .params
+            .keys()
+            .find(|k| !asked.contains(k) && similar(k, key));
+        match typo {
+            Some(t) => self
+                .error(
+                    t,
+                    ErrorKind::MissingParameter,
+                    format!(
+                        "({}) needs parameter `{key}` ({what}); it has `{t}` instead",
+                        self.kind
+                    ),
+                )
+                .hint(format!("did you mean `{key}`? rename `{t}` to `{key}`")),
+            None => self
+                .error(
+                    key,
+                    ErrorKind::MissingParameter,
+                    format!("({}) needs parameter `{key}` ({what})", self.kind),
+                )
+                .hint(format!("add `{key} = …` to element `{}`", self.name)),
+        }
     }
 
     /// Parse `key`'s value as an expression (a TOML number is a constant expression).
