@@ -14,26 +14,31 @@ impl ArmKinematics<'_> {
     /// G(q) of eq. 45.
     #[must_use]
     pub fn gravity_forces(&self) -> DVector<f64> {
-        let arm = self.arm();
-        let mut g = DVector::zeros(arm.n());
-        for p in self.points() {
-            let w0 = wrench(
-                Vector3::new(0.0, -p.mass * arm.gravity(), 0.0),
-                Vector3::zeros(),
-            );
-            let wi = self.pose.screw_to_frame(p.projection.link()).apply(&w0);
-            p.projection
-                .add_transpose_times(&swap(&wi), g.as_mut_slice());
-        }
-        g
+        self.gravity_terms(false).0
     }
 
     /// Gravitational potential `V_g = Σ m g y` (J), zero at y = 0.
     #[must_use]
     pub fn gravity_potential(&self) -> f64 {
-        let g = self.arm().gravity();
-        self.points()
-            .map(|p| p.mass * g * self.pose.position(p.station).y)
-            .sum()
+        self.gravity_terms(true).1
+    }
+
+    /// (G, V_g) in one pass (V_g only if `potential`, else 0).
+    #[must_use]
+    pub fn gravity_terms(&self, potential: bool) -> (DVector<f64>, f64) {
+        let arm = self.arm();
+        let g = arm.gravity();
+        let mut forces = DVector::zeros(arm.n());
+        let mut v = 0.0;
+        for p in self.points() {
+            let w0 = wrench(Vector3::new(0.0, -p.mass * g, 0.0), Vector3::zeros());
+            let wi = self.pose.screw_to_frame(p.projection.link()).apply(&w0);
+            p.projection
+                .add_transpose_times(&swap(&wi), forces.as_mut_slice());
+            if potential {
+                v += p.mass * g * self.pose.position(p.station).y;
+            }
+        }
+        (forces, v)
     }
 }

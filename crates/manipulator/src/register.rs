@@ -22,6 +22,7 @@
 //! lumped_model = "springs"            # "springs" (default), "rigid" or "none"
 //! lumped_stiffness = "k_c"            # N/m, with "springs"
 //! lumped_damping = "c_c"              # N·s/m, with "springs"
+//! paper_reactions = false             # also publish rho{k}_paper (springs only)
 //! ```
 //!
 //! Links are numbered from 1 as in the paper. A link table has `type` = `"beam"` (length, E,
@@ -341,6 +342,17 @@ fn scene(s: &ElementSpec<'_>) -> Result<ArmScene, ModelError> {
         });
         t.finish()?;
     }
+    scene.paper_reactions = match s.raw("paper_reactions") {
+        None => false,
+        Some(Value::Boolean(b)) => *b,
+        Some(_) => {
+            return Err(bad(
+                s,
+                "paper_reactions",
+                "`paper_reactions` must be true or false".into(),
+            ))
+        }
+    };
     scene.lumped_model = match s.string_or("lumped_model", "springs")?.as_str() {
         "springs" => {
             if scene.lumped_masses.is_empty() {

@@ -79,6 +79,9 @@ pub struct ArmScene {
     pub lumped_masses: Vec<LumpedMass>,
     /// How they move.
     pub lumped_model: LumpedMassModel,
+    /// With lumped masses on springs, also publish the reaction forces of the paper's
+    /// variant (masses moving rigidly with their pins) as `rho{k}_paper`.
+    pub paper_reactions: bool,
 }
 
 /// Pad `v` with zeros to length `n`, or complain that it is longer.
@@ -109,6 +112,7 @@ impl ArmScene {
             actuators: Vec::new(),
             lumped_masses: Vec::new(),
             lumped_model: LumpedMassModel::Omitted,
+            paper_reactions: false,
         }
     }
 
@@ -217,7 +221,8 @@ impl ArmScene {
         };
         c.element(
             "rho",
-            ArmReactions::new(arm, &self.actuators, &springs, inputs)?,
+            ArmReactions::new(arm, &self.actuators, &springs, inputs)?
+                .with_paper_variant(self.paper_reactions),
         );
         Ok(c)
     }

@@ -65,7 +65,9 @@ fn drift(rtol: f64, method: Method) -> (f64, f64, String) {
 fn energy_of_the_free_flexible_arm_is_conserved() {
     let rtol = 1e-6;
     let (rel, w1, stats) = drift(rtol, Method::Bdf);
-    eprintln!("rtol {rtol:e}: max |ΔE|/max T = {rel:.2e} over 10 s (max |w1_mid| = {w1:.3} m); {stats}");
+    eprintln!(
+        "rtol {rtol:e}: max |ΔE|/max T = {rel:.2e} over 10 s (max |w1_mid| = {w1:.3} m); {stats}"
+    );
     assert!(rel < rtol, "drift {rel} at rtol {rtol}");
     assert!(w1 > 1e-3, "the links do bend");
 }

@@ -123,6 +123,7 @@ fn pendulum_hanging_at_rest_carries_its_weight() {
         scene.actuators = cylinders();
         scene.lumped_masses = lumped_masses();
         scene.lumped_model = model;
+        scene.paper_reactions = true;
         let (eqs, mut x) = build(&scene, &f);
         if let LumpedMassModel::Springs { stiffness, .. } = model {
             // springs pre-loaded by the weights: k q_y = −m g

@@ -38,8 +38,9 @@ impl ArmCompliance {
         let kin = self.arm.kinematics(q);
         let qv = DVector::from_column_slice(q);
         let kq = &self.k * &qv;
-        let v = kin.gravity_potential() + 0.5 * qv.dot(&kq);
-        (kq - kin.gravity_forces(), v)
+        let (g, vg) = kin.gravity_terms(true);
+        let v = vg + 0.5 * qv.dot(&kq);
+        (kq - g, v)
     }
 }
 

@@ -5,9 +5,9 @@
 //! port 2, in actuator order) and the spring–damper forces on the lumped masses' pins (the
 //! effort on the lumped-mass MTF's port 2). Publishes `rho1 … rho{2 n_links}`: ρ_{2j−1},
 //! ρ_{2j} is the force that the inboard body exerts on link j through joint j, in the axes
-//! of frame j (see [`ArmKinematics::reactions`]). With lumped masses on springs it also
-//! publishes `rho{k}_paper`: the same with the masses moving rigidly with their pins, as the
-//! paper's eqs. 91–94 have it.
+//! of frame j (see [`ArmKinematics::reactions`]). With lumped masses on springs it can also
+//! publish `rho{k}_paper` ([`with_paper_variant`](ArmReactions::with_paper_variant)): the
+//! same with the masses moving rigidly with their pins, as the paper's eqs. 91–94 have it.
 //!
 //! [`ArmKinematics::reactions`]: crate::ArmKinematics::reactions
 
@@ -44,6 +44,7 @@ pub struct ArmReactions {
     inputs: ReactionInputs,
     acts: Vec<(Option<Station>, Option<Station>, LinearActuator)>,
     springs: Vec<(Station, f64)>,
+    paper: bool,
 }
 
 fn station(arm: &PlanarArm, pin: &Pin) -> Result<Option<Station>, ParamError> {
@@ -89,7 +90,15 @@ impl ArmReactions {
             inputs,
             acts,
             springs,
+            paper: false,
         })
+    }
+
+    /// Also publish `rho{k}_paper` (only with lumped masses on springs).
+    #[must_use]
+    pub fn with_paper_variant(mut self, on: bool) -> Self {
+        self.paper = on && !self.springs.is_empty();
+        self
     }
 
     fn n_rho(&self) -> usize {
@@ -128,7 +137,7 @@ impl Element for ArmReactions {
         let mut out: Vec<SignalSpec> = (1..=self.n_rho())
             .map(|k| SignalSpec::scalar(&format!("rho{k}")))
             .collect();
-        if !self.springs.is_empty() {
+        if self.paper {
             out.extend((1..=self.n_rho()).map(|k| SignalSpec::scalar(&format!("rho{k}_paper"))));
         }
         out
@@ -171,7 +180,7 @@ impl Element for ArmReactions {
         for (k, r) in rho.iter().enumerate() {
             io.set_y(k, 0, *r);
         }
-        if !self.springs.is_empty() {
+        if self.paper {
             let paper = kin.reactions(&u, &udot, &loads[..n_act_loads], &self.springs);
             for (k, r) in paper.iter().enumerate() {
                 io.set_y(self.n_rho() + k, 0, *r);
