@@ -131,10 +131,7 @@ impl Registry {
 /// Whether `a` looks like a misspelling of `b`: same ignoring case, one a prefix of the
 /// other, or at most one edit apart.
 pub(crate) fn similar(a: &str, b: &str) -> bool {
-    if a.eq_ignore_ascii_case(b)
-        || (a.len() > 1 && b.starts_with(a))
-        || (b.len() > 1 && a.starts_with(b))
-    {
+    if a.eq_ignore_ascii_case(b) || (a.len() > 1 && b.starts_with(a)) || a.starts_with(b) {
         return true;
     }
     let (a, b): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
