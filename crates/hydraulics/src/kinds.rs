@@ -135,13 +135,15 @@ fn chamber(s: &ElementSpec<'_>) -> Built {
         let side = match s.string_or("side", "piston")?.as_str() {
             "piston" => Side::Piston,
             "rod" => Side::Rod,
-            other => return Err(s.error(
-                "side",
-                ErrorKind::BadParameter,
-                format!(
+            other => {
+                return Err(s.error(
+                    "side",
+                    ErrorKind::BadParameter,
+                    format!(
                     "(hydraulics.chamber) `side` must be \"piston\" or \"rod\", not \"{other}\""
                 ),
-            )),
+                ))
+            }
         };
         Chamber::cylinder(
             side,
@@ -183,7 +185,7 @@ fn end_stop(s: &ElementSpec<'_>) -> Built {
         s.number("s_max", "upper end of the stroke, m")?,
         s.number("k", "stiffness, N/m")?,
         s.number("c", "damping, N·s/m")?,
-        s.number_or("width", 1e-3)?,
+        s.number_or("width", 1e-5)?,
     );
     boxed(s, e)
 }
@@ -254,7 +256,7 @@ fn cylinder(s: &ElementSpec<'_>) -> Result<Composite, ModelError> {
         c.end_stop = Some(EndStopSpec {
             k: s.number("k_stop", "end-stop stiffness, N/m")?,
             c: s.number_or("c_stop", 0.0)?,
-            width: s.number_or("stop_width", 1e-3)?,
+            width: s.number_or("stop_width", 1e-5)?,
         });
     }
     // Valve parameters without a valve would be silently ignored: refuse them.
