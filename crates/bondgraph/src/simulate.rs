@@ -90,6 +90,8 @@ pub struct Settings {
     pub rtol: f64,
     /// Absolute tolerance, scaled per state by its nominal magnitude.
     pub atol: f64,
+    /// Most accepted steps before the run is stopped (a stalled or far too stiff run).
+    pub max_steps: usize,
 }
 
 impl Default for Settings {
@@ -101,6 +103,7 @@ impl Default for Settings {
             method: Method::Bdf,
             rtol: 1e-6,
             atol: 1e-8,
+            max_steps: 10_000_000,
         }
     }
 }
@@ -125,10 +128,10 @@ impl Settings {
                 format!("must be finite and > 0, got {}", self.dt_out),
             );
         }
-        if (self.t_end - self.t_start) / self.dt_out > 1e8 {
+        if (self.t_end - self.t_start) / self.dt_out > 1e7 {
             return bad(
                 "dt_out",
-                format!("{} gives more than 1e8 output rows", self.dt_out),
+                format!("{} gives more than 1e7 output rows", self.dt_out),
             );
         }
         if !(self.rtol.is_finite() && self.rtol > 0.0 && self.rtol < 1.0) {
@@ -551,6 +554,27 @@ fn run_segment(
             jv[k] = (fxp[k] - fx[k]) / sigma;
         }
     };
+    // Equations that are not finite where the segment starts would send the solver after a
+    // NaN step size: refuse at once, naming the culprit.
+    {
+        let mut dx = vec![0.0; n];
+        eqs.rhs(t, x, &mut dx);
+        if dx.iter().any(|v| !v.is_finite()) {
+            let c = eqs
+                .first_non_finite(t, x)
+                .map(|c| format!("; {c}"))
+                .unwrap_or_default();
+            return Err((
+                t,
+                x.to_vec(),
+                SimulationError::Solver {
+                    t,
+                    message: "the equations are not finite at the start".into(),
+                    culprit: c,
+                },
+            ));
+        }
+    }
     let x0 = x.to_vec();
     let problem = OdeBuilder::<M>::new()
         .t0(t)
@@ -563,27 +587,28 @@ fn run_segment(
         Ok(p) => p,
         Err(e) => return Err((t, x.to_vec(), SimulationError::Settings(format!("{e}")))),
     };
-    // Recovered Newton failures must not end a long run (diffsol counts them cumulatively);
-    // a real divergence still ends in a step-size failure.
-    problem.ode_options.max_nonlinear_solver_failures = usize::MAX / 2;
+    // diffsol counts Newton failures cumulatively over a solver's life: recovered failures
+    // must not end a long segment, but a NaN step size never trips the step-size check, so
+    // the limit stays finite.
+    problem.ode_options.max_nonlinear_solver_failures = 10_000;
     problem.ode_options.max_error_test_failures = 100;
     let result = match settings.method {
         Method::Bdf => problem
             .bdf::<LS>()
             .map_err(|e| e.to_string())
-            .map(|s| drive(s, rec, t_stop, &bad, stats)),
+            .map(|s| drive(s, rec, t_stop, settings.max_steps, &bad, stats)),
         Method::Esdirk34 => problem
             .esdirk34::<LS>()
             .map_err(|e| e.to_string())
-            .map(|s| drive(s, rec, t_stop, &bad, stats)),
+            .map(|s| drive(s, rec, t_stop, settings.max_steps, &bad, stats)),
         Method::TrBdf2 => problem
             .tr_bdf2::<LS>()
             .map_err(|e| e.to_string())
-            .map(|s| drive(s, rec, t_stop, &bad, stats)),
+            .map(|s| drive(s, rec, t_stop, settings.max_steps, &bad, stats)),
         Method::Tsit45 => problem
             .tsit45()
             .map_err(|e| e.to_string())
-            .map(|s| drive(s, rec, t_stop, &bad, stats)),
+            .map(|s| drive(s, rec, t_stop, settings.max_steps, &bad, stats)),
     };
     stats.rhs_evals += rhs_calls.get();
     stats.jac_rhs_evals += jac_calls.get();
@@ -624,6 +649,7 @@ fn drive<'a, Eqn, S>(
     mut s: S,
     rec: &mut Recorder<'_>,
     t_stop: f64,
+    max_steps: usize,
     bad: &RefCell<Option<(f64, Vec<f64>)>>,
     stats: &mut Statistics,
 ) -> Result<Vec<f64>, SegmentError>
@@ -673,6 +699,27 @@ where
                 ));
             }
             Ok(reason) => {
+                let h = s.state().h;
+                let stalled =
+                    !t.is_finite() || !h.is_finite() || h.abs() < 1e-14 * t.abs().max(1.0);
+                let too_many = s.get_statistics().number_of_steps + stats.steps >= max_steps;
+                if stalled || too_many {
+                    finish(&s, stats);
+                    let message = if stalled {
+                        format!("the step size collapsed to {h:e}")
+                    } else {
+                        format!("more than {max_steps} steps; hint: the model may be much stiffer than the method (try bdf) or max_steps too small")
+                    };
+                    return Err((
+                        t,
+                        x,
+                        SimulationError::Solver {
+                            t,
+                            message,
+                            culprit: culprit(eqs, bad),
+                        },
+                    ));
+                }
                 watch(&mut rec.watchers, t, &x);
                 if let Some(i) = x.iter().position(|v| !v.is_finite()) {
                     finish(&s, stats);

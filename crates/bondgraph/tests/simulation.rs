@@ -415,7 +415,7 @@ fn invalid_settings_are_refused() {
     for s in bad {
         let run = simulate(&mut eqs, &x0, &s, &[], vec![]);
         assert!(
-            matches!(run.error, Some(SimulationError::Settings(_))),
+            matches!(run.error, Some(SimulationError::InvalidSetting { .. })),
             "{s:?}: {:?}",
             run.error
         );
@@ -423,7 +423,7 @@ fn invalid_settings_are_refused() {
     }
     let run = simulate(&mut eqs, &[0.0], &Settings::default(), &[], vec![]);
     assert!(
-        matches!(run.error, Some(SimulationError::Settings(_))),
+        matches!(run.error, Some(SimulationError::InvalidSetting { .. })),
         "wrong state length: {:?}",
         run.error
     );

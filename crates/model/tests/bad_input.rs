@@ -87,6 +87,30 @@ fn at(e: &ModelError, text: &str, needle: &str) {
     );
 }
 
+/// Assert the error points at the definition of element `el` (its name, at the start of its line).
+#[track_caller]
+fn at_element(e: &ModelError, text: &str, el: &str) {
+    let hits: Vec<usize> = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| {
+            l.strip_prefix(el)
+                .is_some_and(|r| r.trim_start().starts_with('='))
+        })
+        .map(|(i, _)| i + 1)
+        .collect();
+    assert_eq!(
+        hits.len(),
+        1,
+        "test bug: element `{el}` must be defined once in\n{text}"
+    );
+    assert_eq!(
+        (e.line, e.col),
+        (Some(hits[0]), Some(1)),
+        "should point at the definition of `{el}`:\n{e}"
+    );
+}
+
 /// Assert a hint is present and mentions every string of `mentions`.
 #[track_caller]
 fn hint(e: &ModelError, mentions: &[&str]) {
@@ -180,7 +204,7 @@ fn unknown_element_kind() {
     let text = msd_replacing("damper", "damper = { kind = \"Q\", r = \"c\" }");
     let e = error(&text);
     check(&e, ErrorKind::UnknownKind, Some("damper"), &["`Q`"]);
-    at(&e, &text, "damper =");
+    at_element(&e, &text, "damper");
     hint(&e, &["R", "C", "I", "Se"]);
 }
 
@@ -189,7 +213,7 @@ fn near_miss_element_kind_suggests_the_right_one() {
     let text = msd_replacing("damper", "damper = { kind = \"r\", r = \"c\" }");
     let e = error(&text);
     check(&e, ErrorKind::UnknownKind, Some("damper"), &["`r`"]);
-    at(&e, &text, "damper =");
+    at_element(&e, &text, "damper");
     hint(&e, &["did you mean R"]);
 }
 
@@ -198,7 +222,7 @@ fn element_without_kind() {
     let text = msd_replacing("damper", "damper = { r = \"c\" }");
     let e = error(&text);
     check(&e, ErrorKind::Syntax, Some("damper"), &["kind"]);
-    at(&e, &text, "damper =");
+    at_element(&e, &text, "damper");
     hint(&e, &["kind = "]);
 }
 
@@ -254,24 +278,33 @@ fn inertia_and_capacitor_bonded_twice() {
         );
         let e = error(&text);
         check(&e, ErrorKind::Graph, Some(el), &[&format!("`{el}`"), kind]);
-        at(&e, &text, "# twice");
+        at(&e, &text, &format!("\"{el} -> v\" # twice"));
         hint(&e, &[el]);
     }
 }
 
 const LEVER: &str = r#"[elements]
-v1    = { kind = "1" }
-mass1 = { kind = "I", m = 1.0 }
-lever = { kind = "TF", m = 2.0 }
-v2    = { kind = "1" }
-mass2 = { kind = "I", m = 0.5 }
+v1       = { kind = "1" }
+mass1    = { kind = "I", m = 1.0 }
+lever    = { kind = "TF", m = 2.0 }
+force    = { kind = "0" }
+coupling = { kind = "C", c = 0.1 }
+v2       = { kind = "1" }
+mass2    = { kind = "I", m = 0.5 }
 
 [bonds]
 b1 = "v1 -> mass1"
 b2 = "v1 -> lever.1"
-b3 = "lever.2 -> v2"
-b4 = "v2 -> mass2"
+b3 = "lever.2 -> force"
+b4 = "force -> coupling"
+b5 = "force -> v2"
+b6 = "v2 -> mass2"
 "#;
+
+/// `LEVER` with port 2 of the lever left unbonded.
+fn lever_unconnected() -> String {
+    LEVER.replace("b3 = \"lever.2 -> force\"\n", "")
+}
 
 #[test]
 fn the_lever_loads() {
@@ -280,9 +313,7 @@ fn the_lever_loads() {
 
 #[test]
 fn unconnected_port() {
-    let text = LEVER
-        .replace("b3 = \"lever.2 -> v2\"\n", "b3 = \"mass2 -> v2\"\n")
-        .replace("b4 = \"v2 -> mass2\"\n", "");
+    let text = lever_unconnected();
     let e = error(&text);
     check(
         &e,
@@ -290,12 +321,12 @@ fn unconnected_port() {
         Some("lever"),
         &["`lever`", "`2`", "not connected"],
     );
-    at(&e, &text, "lever =");
+    at_element(&e, &text, "lever");
 }
 
 #[test]
 fn port_that_does_not_exist() {
-    let text = LEVER.replace("\"lever.2 -> v2\"", "\"lever.3 -> v2\"");
+    let text = LEVER.replace("\"lever.2 -> force\"", "\"lever.3 -> force\"");
     let e = error(&text);
     check(
         &e,
@@ -303,7 +334,7 @@ fn port_that_does_not_exist() {
         Some("lever"),
         &["`lever`", "`3`", "1, 2"],
     );
-    at(&e, &text, "\"lever.3 -> v2\"");
+    at(&e, &text, "\"lever.3 -> force\"");
 }
 
 #[test]
@@ -316,7 +347,7 @@ fn port_on_a_junction() {
 
 #[test]
 fn same_port_bonded_twice() {
-    let text = LEVER.replace("\"lever.2 -> v2\"", "\"lever.1 -> v2\"");
+    let text = LEVER.replace("\"lever.2 -> force\"", "\"lever.1 -> force\"");
     let e = error(&text);
     check(
         &e,
@@ -324,7 +355,7 @@ fn same_port_bonded_twice() {
         Some("lever"),
         &["`lever`", "`1`", "already"],
     );
-    at(&e, &text, "\"lever.1 -> v2\"");
+    at(&e, &text, "\"lever.1 -> force\"");
 }
 
 #[test]
@@ -340,7 +371,7 @@ fn junction_with_no_bonds() {
         Some("spare"),
         &["`spare`", "no bonds"],
     );
-    at(&e, &text, "spare ");
+    at_element(&e, &text, "spare");
 }
 
 // ---------------------------------------------------------------- dimensions
@@ -363,7 +394,7 @@ b1 = "spring -> puck"
     );
     let el = e.element.clone().expect("names an element");
     assert!(el == "puck" || el == "spring", "{e}");
-    at(&e, text, &format!("{el} "));
+    at_element(&e, text, &el);
 }
 
 // ---------------------------------------------------------------- parameters of elements
@@ -373,7 +404,7 @@ fn resistor_without_r() {
     let text = msd_replacing("damper", "damper = { kind = \"R\" }");
     let e = error(&text);
     check(&e, ErrorKind::MissingParameter, Some("damper"), &["`r`"]);
-    at(&e, &text, "damper =");
+    at_element(&e, &text, "damper");
     hint(&e, &["r = "]);
 }
 
@@ -382,7 +413,7 @@ fn inertia_without_m() {
     let text = msd_replacing("mass", "mass   = { kind = \"I\" }");
     let e = error(&text);
     check(&e, ErrorKind::MissingParameter, Some("mass"), &["`m`"]);
-    at(&e, &text, "mass ");
+    at_element(&e, &text, "mass");
     hint(&e, &["m = "]);
 }
 
@@ -601,10 +632,7 @@ fn zero_transformer_modulus() {
 
 #[test]
 fn zero_gyrator_modulus() {
-    let text = LEVER.replace(
-        "lever = { kind = \"TF\", m = 2.0 }",
-        "lever = { kind = \"GY\", r = 0.0 }",
-    );
+    let text = LEVER.replace("{ kind = \"TF\", m = 2.0 }", "{ kind = \"GY\", r = 0.0 }");
     let e = error(&text);
     check(
         &e,
@@ -1177,8 +1205,8 @@ fn override_of_the_solver() {
 #[test]
 fn modulated_element_reading_an_unknown_signal() {
     let text = LEVER.replace(
-        "lever = { kind = \"TF\", m = 2.0 }",
-        "lever = { kind = \"MTF\", m = \"nope.q\" }",
+        "{ kind = \"TF\", m = 2.0 }",
+        "{ kind = \"MTF\", m = \"nope.q\" }",
     );
     let e = error(&text);
     check(
@@ -1187,7 +1215,7 @@ fn modulated_element_reading_an_unknown_signal() {
         Some("lever"),
         &["`lever`", "`nope.q`"],
     );
-    at_line(&e, &text, "lever =");
+    at_element(&e, &text, "lever");
     hint(&e, &[]);
     assert!(
         !e.message.contains("hint:"),
@@ -1203,15 +1231,13 @@ fn signal_block_reading_an_unknown_signal() {
     );
     let e = error(&text);
     check(&e, ErrorKind::Graph, Some("ctl"), &["`mass1.vv`"]);
-    at_line(&e, &text, "ctl =");
+    at_element(&e, &text, "ctl");
     hint(&e, &["mass1."]);
 }
 
 #[test]
 fn core_graph_errors_keep_their_hint_out_of_the_message() {
-    let unconnected = LEVER
-        .replace("b3 = \"lever.2 -> v2\"\n", "b3 = \"mass2 -> v2\"\n")
-        .replace("b4 = \"v2 -> mass2\"\n", "");
+    let unconnected = lever_unconnected();
     let empty = MSD.replace(
         "damper = { kind = \"R\", r = \"c\" }\n",
         "damper = { kind = \"R\", r = \"c\" }\nspare  = { kind = \"0\" }\n",
@@ -1244,7 +1270,7 @@ fn derivative_causality_names_both_masses() {
     );
     let el = e.element.clone().expect("names an element");
     assert!(el == "cart" || el == "load", "{e}");
-    at(&e, text, &format!("{el} "));
+    at_element(&e, text, &el);
 }
 
 #[test]
@@ -1258,11 +1284,7 @@ fn algebraic_loop_names_the_resistors() {
         &["algebraic loop", "r1", "r2", "r3"],
     );
     let el = e.element.clone().expect("names an element");
-    assert!(
-        text.lines().any(|l| l.starts_with(&format!("{el} "))),
-        "{e}"
-    );
-    at(&e, text, &format!("{el} "));
+    at_element(&e, text, &el);
 }
 
 #[test]
@@ -1281,5 +1303,27 @@ b3 = "j -> r"
     let e = error(text);
     check(&e, ErrorKind::Causality, None, &[]);
     let el = e.element.clone().expect("names an element");
-    at(&e, text, &format!("{el} "));
+    at_element(&e, text, &el);
+}
+
+// ---------------------------------------------------------------- constant expressions
+
+#[test]
+fn constant_expression_counts_as_constant() {
+    // `2*m` reads no signal: it is a constant, so `v0` may use it (p0 = m·v0 = 2·1·3)
+    let text = msd_replacing("mass", "mass   = { kind = \"I\", m = \"2*m\", v0 = 3 }");
+    let m = load(&text).unwrap();
+    assert!(m.x0.iter().any(|&x| (x - 6.0).abs() < 1e-12), "{:?}", m.x0);
+}
+
+#[test]
+fn negative_constant_expression_for_a_resistance() {
+    bad_value(
+        "damper",
+        "damper = { kind = \"R\", r = \"c - 1\" }",
+        "damper",
+        "r",
+        "\"c - 1\"",
+        &["-0.5"],
+    );
 }

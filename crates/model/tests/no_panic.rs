@@ -6,10 +6,13 @@
 
 use std::ops::Range;
 use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{mpsc, Mutex};
+use std::time::Duration;
 
 use bg_model::{Model, Registry};
 use proptest::prelude::*;
-use proptest::test_runner::Config;
+use proptest::test_runner::{Config, TestCaseError, TestRunner};
 
 const MODELS: &[(&str, &str)] = &[
     (
@@ -154,37 +157,65 @@ fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
         .unwrap_or_else(|| "(non-string panic)".into())
 }
 
-/// Load `text`; if it loads and simulates at most 10 s, run it for at most 0.1 s and verify
-/// the checks. Returns the panic message if anything panicked.
-fn exercise(file: &str, text: &str) -> Result<(), String> {
-    catch_unwind(AssertUnwindSafe(|| {
-        match Model::from_text(file, text, &Registry::with_core(), &[]) {
-            Err(e) => {
-                // formatting the error must not panic either
-                let _ = e.to_string();
-            }
-            Ok(mut model) => {
-                let s = &mut model.settings;
-                if s.t_end - s.t_start <= 10.0 {
-                    s.t_end = s.t_start + (s.t_end - s.t_start).min(0.1);
-                    // keep the output grid small: a mutated dt_out could ask for 1e8 rows
-                    if (s.t_end - s.t_start) / s.dt_out <= 1e5 {
-                        if let Ok(out) = model.run() {
-                            let _ = model.verify(&out.trajectory);
-                            let _ = model.run();
+/// How long one load (and short run) may take before it counts as hung.
+const TIME_LIMIT: Duration = Duration::from_secs(10);
+
+/// Set once a case hung: its thread keeps spinning, so later cases only load (no runs), to
+/// keep the remaining cases fast; the hang itself is reported as a failure.
+static HUNG: AtomicBool = AtomicBool::new(false);
+
+#[derive(Debug)]
+enum Verdict {
+    Fine,
+    Panicked(String),
+    Hung,
+}
+
+/// Load `text`; if it loads and its t_end is at most 10 s, run it with t_end clipped to
+/// 0.1 s after t_start and verify its checks. Runs on a worker thread with a time limit.
+fn exercise(file: &str, text: &str) -> Verdict {
+    let (file, text) = (file.to_owned(), text.to_owned());
+    let simulate = !HUNG.load(Ordering::SeqCst);
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        let r = catch_unwind(AssertUnwindSafe(|| {
+            match Model::from_text(&file, &text, &Registry::with_core(), &[]) {
+                Err(e) => {
+                    // formatting the error must not panic either
+                    let _ = e.to_string();
+                }
+                Ok(mut model) => {
+                    let s = &mut model.settings;
+                    if simulate && s.t_end <= 10.0 {
+                        s.t_end = s.t_start + (s.t_end - s.t_start).min(0.1);
+                        // keep the output grid small: a mutated dt_out could ask for 1e8 rows
+                        if (s.t_end - s.t_start) / s.dt_out <= 1e5 {
+                            if let Ok(out) = model.run() {
+                                let _ = model.verify(&out.trajectory);
+                                let _ = model.run();
+                            }
                         }
                     }
                 }
             }
+        }));
+        let _ = tx.send(r.map_err(|p| panic_message(p.as_ref())));
+    });
+    match rx.recv_timeout(TIME_LIMIT) {
+        Ok(Ok(())) => Verdict::Fine,
+        Ok(Err(p)) => Verdict::Panicked(p),
+        Err(_) => {
+            HUNG.store(true, Ordering::SeqCst);
+            Verdict::Hung
         }
-    }))
-    .map_err(|p| panic_message(p.as_ref()))
+    }
 }
 
 #[test]
 fn unmutated_models_do_not_panic() {
     for (name, text) in MODELS {
-        exercise(name, text).unwrap();
+        let v = exercise(name, text);
+        assert!(matches!(v, Verdict::Fine), "{name}: {v:?}");
     }
 }
 
@@ -200,32 +231,60 @@ fn every_line_deleted_and_every_number_replaced() {
         }
         for m in &mutations {
             let mutated = apply(text, m);
-            if let Err(p) = exercise(name, &mutated) {
-                failures.push(format!("{name} with {m:?}: panicked: {p}"));
+            match exercise(name, &mutated) {
+                Verdict::Fine => {}
+                Verdict::Panicked(p) => failures.push(format!("{name} with {m:?}: panicked: {p}")),
+                Verdict::Hung => failures.push(format!(
+                    "{name} with {m:?}: did not finish within {TIME_LIMIT:?}"
+                )),
             }
         }
     }
     assert!(
         failures.is_empty(),
-        "{} panics:\n{}",
+        "{} failures:\n{}",
         failures.len(),
         failures.join("\n")
     );
 }
 
-proptest! {
-    #![proptest_config(Config { cases: 200, failure_persistence: None, ..Config::default() })]
-
-    #[test]
-    fn mutated_models_never_panic(model in 0..MODELS.len(), mutations in prop::collection::vec(mutation(), 1..=3)) {
+/// ~200 random models, each mutated 1 to 3 times. A panic fails the case (and is shrunk);
+/// a hang is recorded without shrinking (each try would leave a thread spinning).
+#[test]
+fn mutated_models_never_panic() {
+    let config = Config {
+        cases: 200,
+        failure_persistence: None,
+        ..Config::default()
+    };
+    let mut runner = TestRunner::new(config);
+    let hangs = Mutex::new(Vec::new());
+    let strategy = (0..MODELS.len(), prop::collection::vec(mutation(), 1..=3));
+    let result = runner.run(&strategy, |(model, mutations)| {
         let (name, text) = MODELS[model];
         let mut mutated = text.to_owned();
         for m in &mutations {
             mutated = apply(&mutated, m);
         }
-        let result = exercise(name, &mutated);
-        prop_assert!(result.is_ok(), "{name} with {mutations:?} panicked: {}\n--- mutated model ---\n{mutated}", result.unwrap_err());
+        match exercise(name, &mutated) {
+            Verdict::Fine => Ok(()),
+            Verdict::Panicked(p) => Err(TestCaseError::fail(format!("{name} with {mutations:?} panicked: {p}\n--- mutated model ---\n{mutated}"))),
+            Verdict::Hung => {
+                hangs.lock().unwrap().push(format!("{name} with {mutations:?}: did not finish within {TIME_LIMIT:?}\n--- mutated model ---\n{mutated}"));
+                Ok(())
+            }
+        }
+    });
+    if let Err(e) = result {
+        panic!("{e}");
     }
+    let hangs = hangs.into_inner().unwrap();
+    assert!(
+        hangs.is_empty(),
+        "{} hangs:\n{}",
+        hangs.len(),
+        hangs.join("\n")
+    );
 }
 
 #[test]

@@ -284,5 +284,6 @@ pub fn settings(method: Method, t_end: f64, dt_out: f64, rtol: f64, atol: f64) -
         method,
         rtol,
         atol,
+        ..Settings::default()
     }
 }
