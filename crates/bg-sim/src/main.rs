@@ -214,7 +214,7 @@ fn run(
             let status = if r.passed { "ok  " } else { "FAIL" };
             if !quiet || !r.passed {
                 println!(
-                    "check {status} {}: max |error| {:.3e} at t = {} (tolerance {:.1e})",
+                    "check {status} {}: max |error| {:.3e} at t = {:.6} (tolerance {:.1e})",
                     r.value, r.max_error, r.t_worst, r.tol
                 );
             }
