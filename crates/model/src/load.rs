@@ -111,6 +111,18 @@ struct ElementDef {
     ports: Vec<(String, String)>,
 }
 
+/// An entry's members in global names: elements, internal bonds (name, from, to), exposed
+/// ports (name, member port), and the parameters it used.
+type Members = (
+    Vec<(String, Box<dyn Element>)>,
+    Vec<(String, String, String)>,
+    Vec<(String, String)>,
+    HashSet<String>,
+);
+
+/// Rebuilt elements by id.
+type Replacements = Vec<(bondgraph::ElementId, Box<dyn Element>)>;
+
 /// What one model-file entry builds into.
 enum BuiltDef {
     One(Box<dyn Element>),
@@ -332,20 +344,11 @@ impl Source {
 impl Source {
     /// Build `def` with `constants` into global members (name, element); a composite's
     /// internal bonds and exposed ports are returned in global names.
-    #[allow(clippy::type_complexity)]
     fn build_members(
         &self,
         def: &ElementDef,
         constants: &IndexMap<String, f64>,
-    ) -> Result<
-        (
-            Vec<(String, Box<dyn Element>)>,
-            Vec<(String, String, String)>,
-            Vec<(String, String)>,
-            HashSet<String>,
-        ),
-        ModelError,
-    > {
+    ) -> Result<Members, ModelError> {
         let (built, used) = self.build_element(def, constants)?;
         match built {
             BuiltDef::One(e) => Ok((vec![(def.name.clone(), e)], Vec::new(), Vec::new(), used)),
@@ -383,7 +386,7 @@ impl Source {
         constants: &IndexMap<String, f64>,
         changed: Option<&HashSet<&String>>,
         span: Option<&Range<usize>>,
-    ) -> Result<Vec<(usize, Box<dyn Element>)>, ModelError> {
+    ) -> Result<Replacements, ModelError> {
         let mut out = Vec::new();
         for def in &self.elements {
             if changed.is_some_and(|c| !def.used.iter().any(|u| c.contains(u))) {
