@@ -9,7 +9,7 @@ fn toml_blocks(text: &str) -> Vec<String> {
     let mut current: Option<String> = None;
     for line in text.lines() {
         match (&mut current, line.trim_start()) {
-            (None, l) if l == "```toml" => current = Some(String::new()),
+            (None, "```toml") => current = Some(String::new()),
             (Some(_), "```") => blocks.extend(current.take()),
             (Some(b), _) => {
                 b.push_str(line);
