@@ -35,7 +35,7 @@
 //! [`elements`]: the I-field ([`ArmInertia`]), C-field ([`ArmCompliance`]), R-field
 //! ([`ArmDamping`]), the MTFs to the cylinders ([`ActuatorTransformer`]) and to the lumped
 //! masses ([`LumpedMassTransformer`]), the lumped masses themselves, and the reaction-force
-//! block ([`ArmReactions`]). [`ArmScene`] wires them into a graph; [`register`] offers the
+//! block ([`ArmReactions`]). [`ArmScene`] wires them into a graph; [`register()`] offers the
 //! scene to model files as the composite kind `manipulator.planar_arm`.
 
 pub mod actuator;
