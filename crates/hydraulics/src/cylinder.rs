@@ -213,6 +213,11 @@ impl Cylinder {
         if let Some(r) = self.r_ext {
             ParamError::positive("r_ext", r)?;
         }
+        if let Some(e) = self.end_stop {
+            ParamError::positive("k_stop", e.k)?;
+            ParamError::non_negative("c_stop", e.c)?;
+            ParamError::positive("stop_width", e.width)?;
+        }
         Ok(())
     }
 

@@ -56,6 +56,10 @@ fn geometry_is_checked_with_the_key_named() {
     assert!(e.message.contains("beta"), "{e}");
     let e = lift_with(r#"r_int = "r_l""#, "r_int = 0.0").unwrap_err();
     assert!(e.message.contains("r_int"), "{e}");
+    let e = lift_with("k_stop = 1e9", "k_stop = -1e9").unwrap_err();
+    assert!(e.message.contains("k_stop"), "{e}");
+    let e = lift_with(r#"p_s = "p_s""#, "p_s = -1.0").unwrap_err();
+    assert!(e.message.contains("p_s"), "{e}");
 }
 
 #[test]
