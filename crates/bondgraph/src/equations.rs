@@ -65,6 +65,8 @@ pub struct StateEquations {
     effort_setter: Vec<ElementId>,
     layouts: Vec<Layout>,
     order: Vec<(ElementId, usize)>,
+    /// `order` without the stages whose results only outputs read (skipped by `rhs`).
+    rhs_order: Vec<(ElementId, usize)>,
     /// Per element, per stage: the variables it writes (for diagnostics).
     writes: Vec<Vec<Vec<Var>>>,
     states: Vec<StateInfo>,
@@ -156,6 +158,7 @@ impl StateEquations {
             effort_setter,
             layouts,
             order: Vec::new(),
+            rhs_order: Vec::new(),
             writes: Vec::new(),
             states,
             bond_offset,
@@ -394,6 +397,35 @@ impl StateEquations {
         match toposort(&dep, None) {
             Ok(order) => {
                 self.order = order.into_iter().map(|ix| dep[ix]).collect();
+                // A stage that writes only signals no element reads (reaction forces, energy
+                // reports) matters for output rows, not for dx/dt: `rhs` skips it.
+                let read: std::collections::HashSet<usize> = self
+                    .layouts
+                    .iter()
+                    .flat_map(|l| l.inputs.iter())
+                    .filter_map(|&(src, dim)| match src {
+                        Source::Signal(o) => Some(o..o + dim),
+                        _ => None,
+                    })
+                    .flatten()
+                    .collect();
+                let output_only = |id: ElementId, s: usize| {
+                    let w = &self.writes[id][s];
+                    !w.is_empty()
+                        && w.iter().all(|v| match *v {
+                            Var::Signal(e, i) => {
+                                let (o, d) = self.layouts[e].outputs[i];
+                                !(o..o + d).any(|k| read.contains(&k))
+                            }
+                            _ => false,
+                        })
+                };
+                self.rhs_order = self
+                    .order
+                    .iter()
+                    .copied()
+                    .filter(|&(id, s)| !output_only(id, s))
+                    .collect();
                 Ok(())
             }
             Err(_) => Err(self.loop_error(&dep, &reads, &writer).into()),
@@ -537,11 +569,13 @@ impl StateEquations {
             signals,
             ..
         } = &mut *ws;
-        self.eval_into(t, x, effort, flow, signals, dx);
+        self.eval_into(&self.rhs_order, t, x, effort, flow, signals, dx);
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn eval_into(
         &self,
+        order: &[(ElementId, usize)],
         t: f64,
         x: &[f64],
         effort: &mut [f64],
@@ -549,7 +583,7 @@ impl StateEquations {
         signals: &mut [f64],
         dx: &mut [f64],
     ) {
-        for &(id, stage) in &self.order {
+        for &(id, stage) in order {
             let mut io = Io {
                 t,
                 x,
@@ -587,7 +621,7 @@ impl StateEquations {
             signals,
             dx,
         } = &mut *ws;
-        self.eval_into(t, x, effort, flow, signals, dx);
+        self.eval_into(&self.order, t, x, effort, flow, signals, dx);
     }
 
     /// Read a probe after [`evaluate`](Self::evaluate) at (t, x).

@@ -423,7 +423,7 @@ fn invalid_settings_are_refused() {
     }
     let run = simulate(&mut eqs, &[0.0], &Settings::default(), &[], vec![]);
     assert!(
-        matches!(run.error, Some(SimulationError::InvalidSetting { .. })),
+        matches!(run.error, Some(SimulationError::Settings(_))),
         "wrong state length: {:?}",
         run.error
     );
