@@ -1,7 +1,10 @@
 //! The `bg-sim` front end as a library: the registry of every element kind this build
-//! knows, shared by the CLI and the workspace tests. No physics lives here.
+//! knows, shared by the CLI and the workspace tests, and the figures of a results CSV
+//! ([`plot`]). No physics lives here.
 
 use bg_model::Registry;
+
+pub mod plot;
 
 /// Every element kind this build knows: the core kinds plus the domain crates'.
 #[must_use]

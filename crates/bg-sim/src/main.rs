@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use bg_model::{inspect, Model};
+use bg_sim::plot::{plot_all, Drawn, Results};
 use bg_sim::registry;
 use bondgraph::{Method, Outcome};
 use clap::{Parser, Subcommand};
@@ -51,6 +52,9 @@ enum Command {
         /// Print only errors.
         #[arg(short, long)]
         quiet: bool,
+        /// Also draw the paper's figures (`bg-sim plot`) from the results into this folder.
+        #[arg(long, value_name = "DIR")]
+        plots: Option<PathBuf>,
     },
     /// Check a model: list elements, bonds with causal strokes, states and problems.
     Check {
@@ -62,6 +66,15 @@ enum Command {
     },
     /// List the element kinds a model file can use.
     Kinds,
+    /// Draw the knuckle boom figures of the paper (Figs. 7-11, 15-18) from a results CSV as
+    /// PNG; figures whose columns are missing are skipped.
+    Plot {
+        /// A CSV written by `bg-sim run`.
+        results: PathBuf,
+        /// Folder for the PNGs (created if needed).
+        #[arg(long, default_value = "out/plots")]
+        out: PathBuf,
+    },
 }
 
 fn main() -> ExitCode {
@@ -77,23 +90,70 @@ fn main() -> ExitCode {
             dt_out,
             set,
             quiet,
-        } => run(
-            &model,
-            output,
-            solver.as_deref(),
-            rtol,
-            atol,
-            t_end,
-            dt_out,
-            &set,
-            quiet,
-        ),
+            plots,
+        } => {
+            let (code, written) = run(
+                &model,
+                output,
+                solver.as_deref(),
+                rtol,
+                atol,
+                t_end,
+                dt_out,
+                &set,
+                quiet,
+            );
+            match (plots, written) {
+                (Some(dir), Some(csv)) => match plot(&csv, &dir, quiet) {
+                    ExitCode::SUCCESS => code,
+                    failed => failed,
+                },
+                _ => code,
+            }
+        }
         Command::Check { model, set } => check(&model, &set),
         Command::Kinds => {
             for (k, info) in registry().kinds() {
                 println!("{k:<24} {}", info.summary);
             }
             ExitCode::SUCCESS
+        }
+        Command::Plot { results, out } => plot(&results, &out, false),
+    }
+}
+
+fn plot(results: &Path, dir: &Path, quiet: bool) -> ExitCode {
+    let drawn = Results::read(results).and_then(|r| plot_all(&r, dir));
+    match drawn {
+        Ok(figures) => {
+            let mut written = 0;
+            for f in &figures {
+                match f {
+                    Drawn::Written(p) => {
+                        written += 1;
+                        if !quiet {
+                            println!("wrote {}", p.display());
+                        }
+                    }
+                    Drawn::Skipped { file, missing } => {
+                        if !quiet {
+                            println!("skipped {file}: no column {}", missing.join(", "));
+                        }
+                    }
+                }
+            }
+            if written == 0 {
+                eprintln!(
+                    "error: {} has none of the columns of the figures (t, q1, l1, p_p1, F_c1, rho1, …)",
+                    results.display()
+                );
+                return ExitCode::from(1);
+            }
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
         }
     }
 }
@@ -109,12 +169,12 @@ fn run(
     dt_out: Option<f64>,
     set: &[String],
     quiet: bool,
-) -> ExitCode {
+) -> (ExitCode, Option<PathBuf>) {
     let mut model = match Model::load(path, &registry(), set) {
         Ok(m) => m,
         Err(e) => {
             eprintln!("error: {e}");
-            return ExitCode::from(2);
+            return (ExitCode::from(2), None);
         }
     };
     if let Some(s) = solver {
@@ -122,7 +182,7 @@ fn run(
             Some(m) => model.settings.method = m,
             None => {
                 eprintln!("error: unknown solver `{s}`\n  hint: solvers are bdf, esdirk34, tr-bdf2, tsit45");
-                return ExitCode::from(2);
+                return (ExitCode::from(2), None);
             }
         }
     }
@@ -140,7 +200,7 @@ fn run(
     }
     if let Err(e) = model.settings.validate() {
         eprintln!("error: {e}");
-        return ExitCode::from(2);
+        return (ExitCode::from(2), None);
     }
     let out_path = output.unwrap_or_else(|| {
         let stem = path
@@ -166,7 +226,7 @@ fn run(
         Ok(o) => o,
         Err(e) => {
             eprintln!("error: {e}");
-            return ExitCode::from(2);
+            return (ExitCode::from(2), None);
         }
     };
     let complete = outcome.error.is_none();
@@ -177,7 +237,7 @@ fn run(
     };
     if let Err(e) = write_csv(&target, &outcome) {
         eprintln!("error: cannot write {}: {e}", target.display());
-        return ExitCode::from(2);
+        return (ExitCode::from(2), None);
     }
     if !quiet {
         println!("solver: {}", outcome.stats);
@@ -223,7 +283,7 @@ fn run(
             }
         }
     }
-    code
+    (code, Some(target))
 }
 
 fn partial_path(p: &Path) -> PathBuf {

@@ -1,0 +1,634 @@
+//! `bg-sim plot`: the figures of Cibicik, Pedersen & Egeland (2019), section 6, drawn as PNG
+//! from a results CSV of `models/knuckle_boom.toml` (or any CSV with the same columns).
+//!
+//! | file | the paper's | columns |
+//! |---|---|---|
+//! | `fig07_coordinates.png` | Fig. 7 | q1, q2, q3; qb1_1..3; qb2_1..3 |
+//! | `fig08_lengths.png` | Fig. 8 | l1, l2; ldot1, ldot2 |
+//! | `fig09_pressures.png` | Fig. 9 | p_p1, p_r1, p_p2, p_r2 |
+//! | `fig10_flows.png` | Fig. 10 | Q_p1, Q_r1, Q_p2, Q_r2 |
+//! | `fig11_valves.png` | Fig. 11 | x_v1, x_v2 (and the commands x_c1, x_c2) |
+//! | `fig15_link1_end.png` | Fig. 15 | x_e1, y_e1 (and w1_mid) |
+//! | `fig16_link2_end.png` | Fig. 16 | x_e2, y_e2 (and w2_mid) |
+//! | `fig17_cylinder_forces.png` | Fig. 17 | F_c1, F_c2 |
+//! | `fig18_reactions.png` | Fig. 18 | rho1..rho6 (and the paper's variant rho{k}_paper) |
+//!
+//! A figure whose required columns are missing is skipped (and reported); optional series
+//! (drawn dashed) are drawn when their columns are there. Text is set in DejaVu Sans, which
+//! the `dejavu` crate ships: no system fonts are needed.
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use plotters::prelude::*;
+use plotters::style::register_font;
+
+/// Why the figures could not be drawn.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum PlotError {
+    /// The CSV could not be read.
+    #[error("cannot read {path}: {source}")]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// The CSV is not a results file (header, then rows of numbers).
+    #[error("{path}:{line}: {message}")]
+    Format {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// The output folder could not be made.
+    #[error("cannot create {path}: {source}")]
+    Dir {
+        /// The folder.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// Drawing or encoding a figure failed.
+    #[error("cannot draw {path}: {message}")]
+    Draw {
+        /// The PNG.
+        path: PathBuf,
+        /// What the drawing backend said.
+        message: String,
+    },
+    /// The bundled font was refused.
+    #[error("cannot load the bundled font DejaVu Sans")]
+    Font,
+}
+
+/// A results table: named columns of equal length, the first one `t`.
+#[derive(Clone, Debug, Default)]
+pub struct Results {
+    names: Vec<String>,
+    columns: Vec<Vec<f64>>,
+}
+
+impl Results {
+    /// Read a CSV written by `bg-sim run`: a header of column names, then rows of numbers.
+    pub fn read(path: &Path) -> Result<Self, PlotError> {
+        let text = std::fs::read_to_string(path).map_err(|source| PlotError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::parse(&text).map_err(|(line, message)| PlotError::Format {
+            path: path.to_path_buf(),
+            line,
+            message,
+        })
+    }
+
+    /// Parse CSV text; errors carry the 1-based line.
+    pub fn parse(text: &str) -> Result<Self, (usize, String)> {
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .filter(|(_, l)| !l.trim().is_empty());
+        let (_, header) = lines
+            .next()
+            .ok_or_else(|| (1, "empty file: expected a header line".to_owned()))?;
+        let names: Vec<String> = header.split(',').map(|s| s.trim().to_owned()).collect();
+        if names.first().map(String::as_str) != Some("t") {
+            return Err((1, "the first column must be `t`".to_owned()));
+        }
+        let mut columns = vec![Vec::new(); names.len()];
+        for (i, line) in lines {
+            let cells: Vec<&str> = line.split(',').collect();
+            if cells.len() != names.len() {
+                return Err((
+                    i + 1,
+                    format!("{} values, the header has {}", cells.len(), names.len()),
+                ));
+            }
+            for (c, cell) in cells.iter().enumerate() {
+                let v: f64 = cell
+                    .trim()
+                    .parse()
+                    .map_err(|_| (i + 1, format!("`{cell}` is not a number")))?;
+                columns[c].push(v);
+            }
+        }
+        if columns[0].is_empty() {
+            return Err((2, "no rows".to_owned()));
+        }
+        Ok(Self { names, columns })
+    }
+
+    /// The column called `name`.
+    #[must_use]
+    pub fn column(&self, name: &str) -> Option<&[f64]> {
+        self.names
+            .iter()
+            .position(|n| n == name)
+            .map(|i| self.columns[i].as_slice())
+    }
+
+    /// The time column.
+    #[must_use]
+    pub fn time(&self) -> &[f64] {
+        &self.columns[0]
+    }
+}
+
+/// One curve: a column, its legend, whether the figure needs it and how it is drawn.
+#[derive(Clone, Copy, Debug)]
+pub struct Series {
+    /// Column name.
+    pub column: &'static str,
+    /// Legend text.
+    pub label: &'static str,
+    /// Optional series are drawn only when their column exists; the figure is drawn without
+    /// them.
+    pub optional: bool,
+    /// Drawn as a thin dashed line (a variant or a command beside the main curves).
+    pub dashed: bool,
+}
+
+/// A required curve.
+const fn s(column: &'static str, label: &'static str) -> Series {
+    Series {
+        column,
+        label,
+        optional: false,
+        dashed: false,
+    }
+}
+
+/// An optional curve, solid.
+const fn opt(column: &'static str, label: &'static str) -> Series {
+    Series {
+        column,
+        label,
+        optional: true,
+        dashed: false,
+    }
+}
+
+/// An optional curve, dashed.
+const fn variant(column: &'static str, label: &'static str) -> Series {
+    Series {
+        column,
+        label,
+        optional: true,
+        dashed: true,
+    }
+}
+
+/// One panel of a figure: curves over time on a common axis.
+#[derive(Clone, Copy, Debug)]
+pub struct Panel {
+    /// The y-axis label, with its unit.
+    pub y_label: &'static str,
+    /// The column values are divided by this (Pa → MPa: 1e6).
+    pub unit: f64,
+    /// The curves.
+    pub series: &'static [Series],
+    /// A close-up: only this time window (s), or the whole run.
+    pub window: Option<(f64, f64)>,
+}
+
+/// One PNG.
+#[derive(Clone, Copy, Debug)]
+pub struct Figure {
+    /// File name.
+    pub file: &'static str,
+    /// Title.
+    pub title: &'static str,
+    /// Panels, top to bottom.
+    pub panels: &'static [Panel],
+}
+
+/// The paper's figures (section 6).
+pub const FIGURES: &[Figure] = &[
+    Figure {
+        file: "fig07_coordinates.png",
+        title: "Fig. 7: generalized coordinates",
+        panels: &[
+            Panel {
+                y_label: "joint angles [rad]",
+                unit: 1.0,
+                series: &[s("q1", "q1"), s("q2", "q2"), s("q3", "q3")],
+                window: None,
+            },
+            Panel {
+                y_label: "Link 1 modes [m]",
+                unit: 1.0,
+                series: &[
+                    s("qb1_1", "qb1_1"),
+                    s("qb1_2", "qb1_2"),
+                    s("qb1_3", "qb1_3"),
+                ],
+                window: None,
+            },
+            Panel {
+                y_label: "Link 2 modes [m]",
+                unit: 1.0,
+                series: &[
+                    s("qb2_1", "qb2_1"),
+                    s("qb2_2", "qb2_2"),
+                    s("qb2_3", "qb2_3"),
+                ],
+                window: None,
+            },
+        ],
+    },
+    Figure {
+        file: "fig08_lengths.png",
+        title: "Fig. 8: cylinder lengths and their rates",
+        panels: &[
+            Panel {
+                y_label: "length [m]",
+                unit: 1.0,
+                series: &[s("l1", "l1"), s("l2", "l2")],
+                window: None,
+            },
+            Panel {
+                y_label: "rate [m/s]",
+                unit: 1.0,
+                series: &[s("ldot1", "dl1/dt"), s("ldot2", "dl2/dt")],
+                window: None,
+            },
+        ],
+    },
+    Figure {
+        file: "fig09_pressures.png",
+        title: "Fig. 9: chamber pressures",
+        panels: &[Panel {
+            y_label: "pressure [MPa]",
+            unit: 1e6,
+            series: &[
+                s("p_p1", "P_p1"),
+                s("p_r1", "P_r1"),
+                s("p_p2", "P_p2"),
+                s("p_r2", "P_r2"),
+            ],
+            window: None,
+        }],
+    },
+    Figure {
+        file: "fig10_flows.png",
+        title: "Fig. 10: valve flows into the chambers",
+        panels: &[Panel {
+            y_label: "flow [l/s]",
+            unit: 1e-3,
+            series: &[
+                s("Q_p1", "Q_p1"),
+                s("Q_r1", "Q_r1"),
+                s("Q_p2", "Q_p2"),
+                s("Q_r2", "Q_r2"),
+            ],
+            window: None,
+        }],
+    },
+    Figure {
+        file: "fig11_valves.png",
+        title: "Fig. 11: valve strokes",
+        panels: &[Panel {
+            y_label: "stroke [-]",
+            unit: 1.0,
+            series: &[
+                s("x_v1", "x_v1"),
+                s("x_v2", "x_v2"),
+                variant("x_c1", "command 1"),
+                variant("x_c2", "command 2"),
+            ],
+            window: None,
+        }],
+    },
+    Figure {
+        file: "fig15_link1_end.png",
+        title: "Fig. 15: end point of Link 1 (frame 0)",
+        panels: &[
+            Panel {
+                y_label: "x [m]",
+                unit: 1.0,
+                series: &[s("x_e1", "x_e1")],
+                window: None,
+            },
+            Panel {
+                y_label: "y [m]",
+                unit: 1.0,
+                series: &[s("y_e1", "y_e1")],
+                window: None,
+            },
+            Panel {
+                y_label: "mid-span deflection [mm]",
+                unit: 1e-3,
+                series: &[opt("w1_mid", "w1(L1/2)")],
+                window: None,
+            },
+            Panel {
+                y_label: "close-up [mm]",
+                unit: 1e-3,
+                series: &[opt("w1_mid", "w1(L1/2), 0-2 s")],
+                window: Some((0.0, 2.0)),
+            },
+        ],
+    },
+    Figure {
+        file: "fig16_link2_end.png",
+        title: "Fig. 16: end point of Link 2 (frame 0)",
+        panels: &[
+            Panel {
+                y_label: "x [m]",
+                unit: 1.0,
+                series: &[s("x_e2", "x_e2")],
+                window: None,
+            },
+            Panel {
+                y_label: "y [m]",
+                unit: 1.0,
+                series: &[s("y_e2", "y_e2")],
+                window: None,
+            },
+            Panel {
+                y_label: "mid-span deflection [mm]",
+                unit: 1e-3,
+                series: &[opt("w2_mid", "w2(L2/2)")],
+                window: None,
+            },
+            Panel {
+                y_label: "close-up [mm]",
+                unit: 1e-3,
+                series: &[opt("w2_mid", "w2(L2/2), 0-2 s")],
+                window: Some((0.0, 2.0)),
+            },
+        ],
+    },
+    Figure {
+        file: "fig17_cylinder_forces.png",
+        title: "Fig. 17: cylinder forces",
+        panels: &[Panel {
+            y_label: "force [kN]",
+            unit: 1e3,
+            series: &[s("F_c1", "F_c1"), s("F_c2", "F_c2")],
+            window: None,
+        }],
+    },
+    Figure {
+        file: "fig18_reactions.png",
+        title: "Fig. 18: reaction forces (dashed: lumped masses rigid with their pins, eqs. 91-94)",
+        panels: &[
+            Panel {
+                y_label: "Joint 1 [kN]",
+                unit: 1e3,
+                series: &[
+                    s("rho1", "rho1"),
+                    s("rho2", "rho2"),
+                    variant("rho1_paper", "rho1 paper"),
+                    variant("rho2_paper", "rho2 paper"),
+                ],
+                window: None,
+            },
+            Panel {
+                y_label: "Joint 2 [kN]",
+                unit: 1e3,
+                series: &[
+                    s("rho3", "rho3"),
+                    s("rho4", "rho4"),
+                    variant("rho3_paper", "rho3 paper"),
+                    variant("rho4_paper", "rho4 paper"),
+                ],
+                window: None,
+            },
+            Panel {
+                y_label: "pendulum pivot [kN]",
+                unit: 1e3,
+                series: &[
+                    s("rho5", "rho5"),
+                    s("rho6", "rho6"),
+                    variant("rho5_paper", "rho5 paper"),
+                    variant("rho6_paper", "rho6 paper"),
+                ],
+                window: None,
+            },
+        ],
+    },
+];
+
+/// What became of one figure.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Drawn {
+    /// Written to this file.
+    Written(PathBuf),
+    /// Skipped: these required columns are missing.
+    Skipped {
+        /// The figure's file name.
+        file: &'static str,
+        /// The missing columns.
+        missing: Vec<&'static str>,
+    },
+}
+
+const FONT: &str = "sans-serif";
+const WIDTH: u32 = 960;
+const PANEL_HEIGHT: u32 = 250;
+const TITLE_HEIGHT: u32 = 36;
+
+fn font() -> Result<(), PlotError> {
+    static REGISTERED: OnceLock<bool> = OnceLock::new();
+    let ok = *REGISTERED.get_or_init(|| {
+        register_font(FONT, FontStyle::Normal, dejavu::sans::regular()).is_ok()
+            && register_font(FONT, FontStyle::Bold, dejavu::sans::bold()).is_ok()
+    });
+    if ok {
+        Ok(())
+    } else {
+        Err(PlotError::Font)
+    }
+}
+
+/// Draw every figure of [`FIGURES`] whose columns `results` has into `dir` (created if
+/// needed).
+pub fn plot_all(results: &Results, dir: &Path) -> Result<Vec<Drawn>, PlotError> {
+    std::fs::create_dir_all(dir).map_err(|source| PlotError::Dir {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    FIGURES.iter().map(|f| plot(results, f, dir)).collect()
+}
+
+/// Draw one figure into `dir`.
+pub fn plot(results: &Results, figure: &Figure, dir: &Path) -> Result<Drawn, PlotError> {
+    let missing: Vec<&'static str> = figure
+        .panels
+        .iter()
+        .flat_map(|p| p.series.iter())
+        .filter(|s| !s.optional && results.column(s.column).is_none())
+        .map(|s| s.column)
+        .collect();
+    let panels: Vec<&Panel> = figure
+        .panels
+        .iter()
+        .filter(|p| p.series.iter().any(|s| results.column(s.column).is_some()))
+        .collect();
+    if !missing.is_empty() || panels.is_empty() {
+        return Ok(Drawn::Skipped {
+            file: figure.file,
+            missing,
+        });
+    }
+    font()?;
+    let path = dir.join(figure.file);
+    let fail = |e: &dyn std::fmt::Display| PlotError::Draw {
+        path: path.clone(),
+        message: e.to_string(),
+    };
+    let height = TITLE_HEIGHT + PANEL_HEIGHT * panels.len() as u32;
+    {
+        let root = BitMapBackend::new(&path, (WIDTH, height)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| fail(&e))?;
+        let (top, body) = root.split_vertically(TITLE_HEIGHT);
+        top.titled(figure.title, (FONT, 20).into_font().style(FontStyle::Bold))
+            .map_err(|e| fail(&e))?;
+        for (panel, area) in panels.iter().zip(body.split_evenly((panels.len(), 1))) {
+            draw_panel(results, panel, &area).map_err(|e| fail(&e))?;
+        }
+        root.present().map_err(|e| fail(&e))?;
+    }
+    Ok(Drawn::Written(path))
+}
+
+type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
+type DrawResult<T> =
+    Result<T, DrawingAreaErrorKind<<BitMapBackend<'static> as DrawingBackend>::ErrorType>>;
+
+const COLORS: [RGBColor; 4] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+];
+
+/// The y range of the curves, padded by 5 % (and widened around a constant).
+fn y_range(curves: &[(Series, Vec<(f64, f64)>)]) -> (f64, f64) {
+    let (lo, hi) = curves
+        .iter()
+        .flat_map(|(_, pts)| pts.iter().map(|p| p.1))
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+    if !lo.is_finite() {
+        return (-1.0, 1.0);
+    }
+    let span = hi - lo;
+    let pad = if span > 1e-12 * lo.abs().max(hi.abs()).max(1e-300) {
+        0.05 * span
+    } else {
+        0.5 * lo.abs().max(1e-9)
+    };
+    (lo - pad, hi + pad)
+}
+
+fn draw_panel(results: &Results, panel: &Panel, area: &Area<'_>) -> DrawResult<()> {
+    let t = results.time();
+    let (mut t0, mut t1) = (t[0], t[t.len() - 1]);
+    if let Some((a, b)) = panel.window {
+        (t0, t1) = (t0.max(a), t1.min(b));
+    }
+    let t1 = t1.max(t0 + 1e-12);
+    let curves: Vec<(Series, Vec<(f64, f64)>)> = panel
+        .series
+        .iter()
+        .filter_map(|s| {
+            results.column(s.column).map(|c| {
+                let pts = t
+                    .iter()
+                    .zip(c)
+                    .filter(|(&t, _)| (t0..=t1).contains(&t))
+                    .map(|(&t, &v)| (t, v / panel.unit))
+                    .collect();
+                (*s, pts)
+            })
+        })
+        .collect();
+    let (y0, y1) = y_range(&curves);
+    let mut chart = ChartBuilder::on(area)
+        .margin(8)
+        .margin_right(16)
+        .x_label_area_size(34)
+        .y_label_area_size(78)
+        .build_cartesian_2d(t0..t1, y0..y1)?;
+    chart
+        .configure_mesh()
+        .x_desc("t [s]")
+        .y_desc(panel.y_label)
+        .label_style((FONT, 14))
+        .axis_desc_style((FONT, 15))
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()?;
+    let mut solid = 0;
+    let mut dashed = 0;
+    for (s, pts) in curves {
+        let (color, width) = if s.dashed {
+            dashed += 1;
+            (COLORS[(dashed - 1) % COLORS.len()].mix(0.9), 1)
+        } else {
+            solid += 1;
+            (COLORS[(solid - 1) % COLORS.len()].mix(1.0), 2)
+        };
+        let style = color.stroke_width(width);
+        let legend = move |(x, y): (i32, i32)| {
+            PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(width))
+        };
+        if s.dashed {
+            chart
+                .draw_series(DashedLineSeries::new(pts, 6, 4, style))?
+                .label(s.label)
+                .legend(legend);
+        } else {
+            chart
+                .draw_series(LineSeries::new(pts, style))?
+                .label(s.label)
+                .legend(legend);
+        }
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(RGBColor(180, 180, 180))
+        .label_font((FONT, 14))
+        .draw()?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parse_reads_columns_and_names_bad_lines() {
+        let r = Results::parse("t,a\n0,1\n0.5,2\n").unwrap_or_default();
+        assert_eq!(r.column("a"), Some(&[1.0, 2.0][..]));
+        assert_eq!(r.time(), &[0.0, 0.5]);
+        assert!(r.column("b").is_none());
+        assert_eq!(Results::parse("t,a\n0,x\n").err().map(|e| e.0), Some(2));
+        assert_eq!(Results::parse("t,a\n0\n").err().map(|e| e.0), Some(2));
+        assert_eq!(Results::parse("x,a\n0,1\n").err().map(|e| e.0), Some(1));
+        assert!(Results::parse("").is_err());
+        assert!(Results::parse("t\n").is_err());
+    }
+
+    #[test]
+    fn y_range_pads_and_widens_constants() {
+        let c = |v: &[f64]| vec![(s("a", "a"), v.iter().map(|&y| (0.0, y)).collect())];
+        let (lo, hi) = y_range(&c(&[0.0, 10.0]));
+        assert!((lo + 0.5).abs() < 1e-12 && (hi - 10.5).abs() < 1e-12);
+        let (lo, hi) = y_range(&c(&[2.0, 2.0]));
+        assert!(lo < 2.0 && hi > 2.0);
+        let (lo, hi) = y_range(&c(&[0.0]));
+        assert!(lo < 0.0 && hi > 0.0);
+        assert_eq!(y_range(&c(&[f64::NAN])), (-1.0, 1.0));
+    }
+}
