@@ -249,11 +249,31 @@ pub trait Element: Debug {
         Vec::new()
     }
 
+    /// Bounds on states: a run that reaches one stops there, exactly (by root finding), with
+    /// [`SimulationError::LimitReached`](crate::SimulationError::LimitReached) and the
+    /// element's message (a piston leaving its stroke with no end stop).
+    fn limits(&self) -> Vec<Limit> {
+        Vec::new()
+    }
+
     /// Energy stored at states `x` (for energy-balance tests), if the element stores any.
     fn stored_energy(&self, x: &[f64]) -> Option<f64> {
         let _ = x;
         None
     }
+}
+
+/// Bounds on one of an element's states (`f64::NEG_INFINITY` / `f64::INFINITY` for none).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Limit {
+    /// Index of the state within the element's states.
+    pub state: usize,
+    /// Lower bound.
+    pub lower: f64,
+    /// Upper bound.
+    pub upper: f64,
+    /// What reaching it means and what to do, e.g. "the piston left its stroke; add an end stop".
+    pub message: String,
 }
 
 /// A state whose minimum the simulator records over a run, at every accepted step.

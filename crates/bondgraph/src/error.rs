@@ -277,6 +277,22 @@ pub enum SimulationError {
         /// Where a non-finite value first appeared in the equations.
         culprit: String,
     },
+    /// A state reached a bound its element set ([`Limit`](crate::element::Limit)).
+    #[error("state `{state}` of element `{element}` reached its {which} limit {limit} at t = {t:.9} s: {message}")]
+    LimitReached {
+        /// Time of the crossing.
+        t: f64,
+        /// State name.
+        state: String,
+        /// Element owning the state.
+        element: String,
+        /// `lower` or `upper`.
+        which: &'static str,
+        /// The bound.
+        limit: f64,
+        /// The element's explanation.
+        message: String,
+    },
     /// A scheduled event could not be applied.
     #[error("event at t = {t} s: {source}")]
     Event {

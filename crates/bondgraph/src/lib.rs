@@ -59,7 +59,8 @@ pub mod simulate;
 pub use bond::{Bond, BondId, ElementId, Endpoint, PortCausality};
 pub use causality::{assign_causality, CausalGraph};
 pub use element::{
-    CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Slot, Stage, StateSpec, Watch,
+    CausalRule, Element, Io, Limit, Param, PortSpec, Ports, SignalSpec, Slot, Stage, StateSpec,
+    Watch,
 };
 pub use elements::*;
 pub use equations::{Probe, StateEquations, StateInfo};

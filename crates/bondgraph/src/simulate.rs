@@ -249,6 +249,67 @@ pub struct WatchReport {
     pub warning: Option<String>,
 }
 
+/// One side of a [`Limit`](crate::element::Limit), as a root function of the solver.
+#[derive(Clone, Debug)]
+struct Bound {
+    index: usize,
+    value: f64,
+    upper: bool,
+    element: String,
+    state: String,
+    message: String,
+}
+
+impl Bound {
+    /// Positive inside the bound, zero on it.
+    fn margin(&self, x: &[f64]) -> f64 {
+        if self.upper {
+            self.value - x[self.index]
+        } else {
+            x[self.index] - self.value
+        }
+    }
+    fn error(&self, t: f64) -> SimulationError {
+        SimulationError::LimitReached {
+            t,
+            state: self.state.clone(),
+            element: self.element.clone(),
+            which: if self.upper { "upper" } else { "lower" },
+            limit: self.value,
+            message: self.message.clone(),
+        }
+    }
+}
+
+fn bounds(eqs: &StateEquations) -> Vec<Bound> {
+    let mut v = Vec::new();
+    for id in 0..eqs.graph().n_elements() {
+        let node = eqs.graph().node(id);
+        let Some(first) = eqs.states().iter().position(|s| s.element == id) else {
+            continue;
+        };
+        for l in node.element.limits() {
+            let index = first + l.state;
+            let Some(info) = eqs.states().get(index) else {
+                continue;
+            };
+            for (value, upper) in [(l.lower, false), (l.upper, true)] {
+                if value.is_finite() {
+                    v.push(Bound {
+                        index,
+                        value,
+                        upper,
+                        element: node.name.clone(),
+                        state: info.name.clone(),
+                        message: l.message.clone(),
+                    });
+                }
+            }
+        }
+    }
+    v
+}
+
 struct Watcher {
     index: usize,
     report: WatchReport,
@@ -401,6 +462,10 @@ pub fn simulate(
             value: *v,
             culprit: " (initial value)".into(),
         });
+        return out;
+    }
+    if let Some(b) = bounds(eqs).iter().find(|b| b.margin(x0) < 0.0) {
+        out.error = Some(b.error(settings.t_start));
         return out;
     }
     let start = Instant::now();
@@ -576,12 +641,23 @@ fn run_segment(
         }
     }
     let x0 = x.to_vec();
+    let limits = bounds(eqs);
+    let n_roots = limits.len();
+    let roots_of = limits.clone();
     let problem = OdeBuilder::<M>::new()
         .t0(t)
         .rtol(settings.rtol)
         .atol(atol)
         .rhs_implicit(rhs, jvp)
         .init(move |_p, _t, y| y.copy_from_slice(&x0), n)
+        .root(
+            move |x, _p, _t, g| {
+                for (gk, b) in g.iter_mut().zip(&roots_of) {
+                    *gk = b.margin(x);
+                }
+            },
+            n_roots,
+        )
         .build();
     let mut problem = match problem {
         Ok(p) => p,
@@ -596,19 +672,19 @@ fn run_segment(
         Method::Bdf => problem
             .bdf::<LS>()
             .map_err(|e| e.to_string())
-            .map(|s| drive(s, rec, t_stop, settings.max_steps, &bad, stats)),
+            .map(|s| drive(s, rec, t_stop, settings.max_steps, &limits, &bad, stats)),
         Method::Esdirk34 => problem
             .esdirk34::<LS>()
             .map_err(|e| e.to_string())
-            .map(|s| drive(s, rec, t_stop, settings.max_steps, &bad, stats)),
+            .map(|s| drive(s, rec, t_stop, settings.max_steps, &limits, &bad, stats)),
         Method::TrBdf2 => problem
             .tr_bdf2::<LS>()
             .map_err(|e| e.to_string())
-            .map(|s| drive(s, rec, t_stop, settings.max_steps, &bad, stats)),
+            .map(|s| drive(s, rec, t_stop, settings.max_steps, &limits, &bad, stats)),
         Method::Tsit45 => problem
             .tsit45()
             .map_err(|e| e.to_string())
-            .map(|s| drive(s, rec, t_stop, settings.max_steps, &bad, stats)),
+            .map(|s| drive(s, rec, t_stop, settings.max_steps, &limits, &bad, stats)),
     };
     stats.rhs_evals += rhs_calls.get();
     stats.jac_rhs_evals += jac_calls.get();
@@ -650,6 +726,7 @@ fn drive<'a, Eqn, S>(
     rec: &mut Recorder<'_>,
     t_stop: f64,
     max_steps: usize,
+    limits: &[Bound],
     bad: &RefCell<Option<(f64, Vec<f64>)>>,
     stats: &mut Statistics,
 ) -> Result<Vec<f64>, SegmentError>
@@ -733,8 +810,18 @@ where
                     };
                     return Err((t, x, err));
                 }
+                // A limit reached inside the step: rows up to the crossing, then stop there.
+                let root = match reason {
+                    OdeSolverStopReason::RootFound(tr, idx) => Some((tr, idx)),
+                    _ => None,
+                };
+                let t_rows = root.map_or(t, |(tr, _)| tr);
                 while let Some(tg) = rec.pending() {
-                    if tg > t || same_time(tg, t_stop) || tg > t_stop {
+                    if tg > t_rows
+                        || same_time(tg, t_stop)
+                        || tg > t_stop
+                        || (root.is_some() && same_time(tg, t_rows))
+                    {
                         break;
                     }
                     if same_time(tg, t) {
@@ -756,6 +843,22 @@ where
                             }
                         }
                     }
+                }
+                if let Some((tr, idx)) = root {
+                    finish(&s, stats);
+                    let xr = match s.interpolate(tr) {
+                        Ok(y) => y.batch_as_slice(0).to_vec(),
+                        Err(_) => x,
+                    };
+                    let err = limits.get(idx).map_or_else(
+                        || SimulationError::Solver {
+                            t: tr,
+                            message: format!("root {idx} found, but no limit has that index"),
+                            culprit: String::new(),
+                        },
+                        |b| b.error(tr),
+                    );
+                    return Err((tr, xr, err));
                 }
                 if matches!(reason, OdeSolverStopReason::TstopReached) {
                     finish(&s, stats);

@@ -15,19 +15,17 @@
 //!
 //! Causality is fixed: the mechanism sets the velocity, the chambers set the pressures
 //! (`p`, `r` receive effort; `mech` sets it). The piston publishes `l = l⁰ + s` (the cylinder
-//! length, m) for controllers, and `past_stroke_end`.
+//! length, m) for controllers.
 //!
-//! **Leaving the stroke range.** An element cannot return an error from its evaluation, so a
-//! piston *without* an end stop (`guard = true`) reports a stroke outside `[0, s_max]` the one
-//! way the core stops a run and names the culprit: it sets its signal `past_stroke_end` and
-//! the stroke rate ṡ to NaN. The solver rejects every step that ends past the stroke end, and
-//! the run stops with an error naming `signal <piston>.past_stroke_end = NaN, computed by
-//! <piston> (hydraulics.piston)`. The rows before are kept and are all finite. With an end
-//! stop (`guard = false`) the piston goes on past the ends and the stop pushes it back.
+//! **Leaving the stroke range.** A piston *without* an end stop (`guard = true`) declares its
+//! stroke's bounds `[0, s_max]` as a [`Limit`]: the solver locates the crossing exactly (root
+//! finding) and the run stops there with `SimulationError::LimitReached`, naming the piston,
+//! its state `s`, the bound and the time. The rows before are kept. With an end stop
+//! (`guard = false`) the piston goes on past the ends and the stop pushes it back.
 
 use bondgraph::{
-    CausalRule, Element, Io, ParamError, PortCausality, PortSpec, Ports, SignalSpec, Slot, Stage,
-    StateSpec,
+    CausalRule, Element, Io, Limit, ParamError, PortCausality, PortSpec, Ports, SignalSpec, Slot,
+    Stage, StateSpec,
 };
 
 /// Piston with areas `a_p` (piston side) and `a_r` (rod side, annulus), m², and its stroke.
@@ -82,12 +80,6 @@ impl Piston {
         self.a_p * p_p - self.a_r * p_r
     }
 
-    /// Whether stroke `s` is outside the guarded range (always false without the guard).
-    #[must_use]
-    pub fn past_end(&self, s: f64) -> bool {
-        self.guard && !(0.0..=self.s_max).contains(&s)
-    }
-
     fn v(io: &Io<'_>) -> f64 {
         -io.f_in(2, 0)
     }
@@ -112,15 +104,12 @@ impl Element for Piston {
         vec![StateSpec::new("s", self.s0).nominal(self.s_max)]
     }
     fn signal_outputs(&self) -> Vec<SignalSpec> {
-        vec![
-            SignalSpec::scalar("l"),
-            SignalSpec::scalar("past_stroke_end"),
-        ]
+        vec![SignalSpec::scalar("l")]
     }
     fn stages(&self, _: &[PortCausality]) -> Vec<Stage> {
         vec![
             Stage {
-                writes: vec![Slot::Output(0), Slot::Output(1)],
+                writes: vec![Slot::Output(0)],
                 reads: Vec::new(),
             },
             Stage {
@@ -138,7 +127,6 @@ impl Element for Piston {
             0 => {
                 let s = io.states()[0];
                 io.set_y(0, 0, self.l0 + s);
-                io.set_y(1, 0, if self.past_end(s) { f64::NAN } else { 0.0 });
             }
             1 => {
                 let f = self.force(io.e(0, 0), io.e(1, 0));
@@ -152,11 +140,21 @@ impl Element for Piston {
         }
     }
     fn derivatives(&self, io: &Io<'_>, dx: &mut [f64]) {
-        dx[0] = if self.past_end(io.states()[0]) {
-            f64::NAN
-        } else {
-            Self::v(io)
-        };
+        dx[0] = Self::v(io);
+    }
+    fn limits(&self) -> Vec<Limit> {
+        if !self.guard {
+            return Vec::new();
+        }
+        vec![Limit {
+            state: 0,
+            lower: 0.0,
+            upper: self.s_max,
+            message: format!(
+                "the piston left its stroke [0, {}] m and the cylinder has no end stop; hint: add an end stop (k_stop, c_stop) or keep the set-point inside the stroke",
+                self.s_max
+            ),
+        }]
     }
 }
 
@@ -172,12 +170,14 @@ mod tests {
     }
 
     #[test]
-    fn guard_covers_exactly_the_stroke() {
+    fn guard_limits_exactly_the_stroke() {
         let p = Piston::new(0.04, 0.03, 3.5, 0.0, 2.7, true).unwrap();
-        assert!(!p.past_end(0.0) && !p.past_end(2.7) && !p.past_end(1.0));
-        assert!(p.past_end(-1e-12) && p.past_end(2.7 + 1e-12));
+        let l = p.limits();
+        assert_eq!(l.len(), 1);
+        assert_eq!((l[0].state, l[0].lower, l[0].upper), (0, 0.0, 2.7));
+        assert!(l[0].message.contains("end stop"));
         let q = Piston::new(0.04, 0.03, 3.5, 0.0, 2.7, false).unwrap();
-        assert!(!q.past_end(-1.0) && !q.past_end(5.0));
+        assert!(q.limits().is_empty());
     }
 
     #[test]

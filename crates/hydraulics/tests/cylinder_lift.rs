@@ -159,8 +159,17 @@ fn commanded_past_the_stroke_without_end_stop_it_stops_with_a_clear_error() {
     let out = m.run().unwrap();
     let err = out.error.as_ref().expect("the run must stop").to_string();
     eprintln!("without an end stop: {err}\n  ({})", out.stats);
-    assert!(err.contains("past_stroke_end"), "{err}");
-    assert!(err.contains("lift_piston"), "{err}");
+    assert!(
+        matches!(
+            out.error,
+            Some(bondgraph::SimulationError::LimitReached { which: "upper", .. })
+        ),
+        "{err}"
+    );
+    assert!(
+        err.contains("lift_piston") && err.contains("end stop"),
+        "{err}"
+    );
     // never a NaN in the results: the rows computed are finite, and the run got to the end
     // of the stroke (0.205 m/s from l = 1.4 m reaches l_max = 2.2 m after about 3.9 s)
     let tr = &out.trajectory;
@@ -169,6 +178,14 @@ fn commanded_past_the_stroke_without_end_stop_it_stops_with_a_clear_error() {
     let l_max = m.parameters["l0"] + m.parameters["s_max"];
     assert!(l.iter().all(|&x| x <= l_max));
     assert!(last(&l) > l_max - 2e-3, "{}", last(&l));
+    // the solver stops exactly on the stroke end
+    let s_end = out.x_final[m
+        .equations
+        .states()
+        .iter()
+        .position(|s| s.name == "lift_piston.s")
+        .unwrap()];
+    assert!((s_end - m.parameters["s_max"]).abs() < 1e-6, "{s_end}");
     assert!((3.8..4.0).contains(&out.t_final), "{}", out.t_final);
 }
 
