@@ -565,7 +565,8 @@ fn draw_panel(results: &Results, panel: &Panel, area: &Area<'_>) -> DrawResult<(
         .y_desc(panel.y_label)
         .label_style((FONT, 14))
         .axis_desc_style((FONT, 15))
-        .light_line_style(RGBColor(235, 235, 235))
+        .light_line_style(RGBColor(238, 238, 238))
+        .max_light_lines(2)
         .draw()?;
     let mut solid = 0;
     let mut dashed = 0;
