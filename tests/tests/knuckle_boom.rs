@@ -813,6 +813,10 @@ fn the_run_writes_the_design_page_columns() {
         assert!(names.contains(&c), "missing column {c}");
     }
     assert!((m.settings.t_end - 20.0).abs() < 1e-12);
+    // one event, at t_switch (event times are numbers, so the parameter is kept equal)
+    let events = m.events().unwrap();
+    assert_eq!(events.len(), 1);
+    assert!((events[0].t - m.parameters["t_switch"]).abs() < 1e-15);
     assert!((m.settings.dt_out - 0.01).abs() < 1e-15);
     // the design page's areas and the retracted geometry
     let p = &m.parameters;
