@@ -66,8 +66,9 @@ pub enum PlotError {
     Font,
 }
 
-/// A results table: named columns of equal length, the first one `t`.
-#[derive(Clone, Debug, Default)]
+/// A results table: named columns of equal length, the first one `t`, at least one row
+/// (made only by [`Results::read`] and [`Results::parse`], which check that).
+#[derive(Clone, Debug)]
 pub struct Results {
     names: Vec<String>,
     columns: Vec<Vec<f64>>,
@@ -605,12 +606,13 @@ fn draw_panel(results: &Results, panel: &Panel, area: &Area<'_>) -> DrawResult<(
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
 
     #[test]
     fn parse_reads_columns_and_names_bad_lines() {
-        let r = Results::parse("t,a\n0,1\n0.5,2\n").unwrap_or_default();
+        let r = Results::parse("t,a\n0,1\n0.5,2\n").unwrap();
         assert_eq!(r.column("a"), Some(&[1.0, 2.0][..]));
         assert_eq!(r.time(), &[0.0, 0.5]);
         assert!(r.column("b").is_none());
