@@ -431,9 +431,10 @@ pub enum Drawn {
 }
 
 const FONT: &str = "sans-serif";
-const WIDTH: u32 = 960;
+const WIDTH: u32 = 1040;
 const PANEL_HEIGHT: u32 = 250;
 const TITLE_HEIGHT: u32 = 36;
+const LEGEND_WIDTH: u32 = 130;
 
 fn font() -> Result<(), PlotError> {
     static REGISTERED: OnceLock<bool> = OnceLock::new();
@@ -554,9 +555,10 @@ fn draw_panel(results: &Results, panel: &Panel, area: &Area<'_>) -> DrawResult<(
         })
         .collect();
     let (y0, y1) = y_range(&curves);
-    let mut chart = ChartBuilder::on(area)
+    // the legend sits right of the chart, so it never hides a curve
+    let (plot_area, legend_area) = area.split_horizontally(WIDTH - LEGEND_WIDTH);
+    let mut chart = ChartBuilder::on(&plot_area)
         .margin(8)
-        .margin_right(16)
         .x_label_area_size(34)
         .y_label_area_size(78)
         .build_cartesian_2d(t0..t1, y0..y1)?;
@@ -571,7 +573,7 @@ fn draw_panel(results: &Results, panel: &Panel, area: &Area<'_>) -> DrawResult<(
         .draw()?;
     let mut solid = 0;
     let mut dashed = 0;
-    for (s, pts) in curves {
+    for (i, (s, pts)) in curves.into_iter().enumerate() {
         let (color, width) = if s.dashed {
             dashed += 1;
             (COLORS[(dashed - 1) % COLORS.len()].mix(0.9), 1)
@@ -580,28 +582,22 @@ fn draw_panel(results: &Results, panel: &Panel, area: &Area<'_>) -> DrawResult<(
             (COLORS[(solid - 1) % COLORS.len()].mix(1.0), 2)
         };
         let style = color.stroke_width(width);
-        let legend = move |(x, y): (i32, i32)| {
-            PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(width))
-        };
+        let y = 24 + 22 * i as i32;
         if s.dashed {
-            chart
-                .draw_series(DashedLineSeries::new(pts, 6, 4, style))?
-                .label(s.label)
-                .legend(legend);
+            chart.draw_series(DashedLineSeries::new(pts, 6, 4, style))?;
+            for x in [4, 16] {
+                legend_area.draw(&PathElement::new(vec![(x, y), (x + 8, y)], style))?;
+            }
         } else {
-            chart
-                .draw_series(LineSeries::new(pts, style))?
-                .label(s.label)
-                .legend(legend);
+            chart.draw_series(LineSeries::new(pts, style))?;
+            legend_area.draw(&PathElement::new(vec![(4, y), (28, y)], style))?;
         }
+        legend_area.draw(&Text::new(
+            s.label,
+            (34, y - 8),
+            (FONT, 14).into_font().color(&BLACK),
+        ))?;
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(RGBColor(180, 180, 180))
-        .label_font((FONT, 14))
-        .draw()?;
     Ok(())
 }
 
