@@ -315,6 +315,42 @@ fn scene(s: &ElementSpec<'_>) -> Result<ArmScene, ModelError> {
     scene.q0 = s.vector_or("q0", Vec::new())?;
     scene.u0 = s.vector_or("u0", Vec::new())?;
     scene.damping = s.vector_or("damping", Vec::new())?;
+    // Damping by kind, independent of the number of modes: one value per joint and one for
+    // every modal coordinate (or one per link).
+    if s.has("joint_damping") || s.has("modal_damping") {
+        if !scene.damping.is_empty() {
+            return Err(bad(s, "damping", "give either `damping` (one entry per coordinate) or `joint_damping` and `modal_damping`, not both".into()));
+        }
+        let n_links = scene.links.len();
+        let joints = s.vector_or("joint_damping", vec![0.0; n_links])?;
+        if joints.len() != n_links {
+            return Err(bad(
+                s,
+                "joint_damping",
+                format!(
+                    "`joint_damping` needs one value per joint ({n_links}), got {}",
+                    joints.len()
+                ),
+            ));
+        }
+        let modal = s.vector_or("modal_damping", vec![0.0])?;
+        if modal.len() != 1 && modal.len() != n_links {
+            return Err(bad(
+                s,
+                "modal_damping",
+                format!(
+                    "`modal_damping` needs one value, or one per link ({n_links}), got {}",
+                    modal.len()
+                ),
+            ));
+        }
+        let mut d = joints;
+        for (i, l) in scene.links.iter().enumerate() {
+            let r = if modal.len() == 1 { modal[0] } else { modal[i] };
+            d.extend(std::iter::repeat_n(r, l.modes().len()));
+        }
+        scene.damping = d;
+    }
     for (k, v) in array(s, "actuators")?.iter().enumerate() {
         let t = Table::new(s, "actuators", format!("actuators[{}]", k + 1), v)?;
         let ends = ["from", "to"].map(|e| {
@@ -353,18 +389,22 @@ fn scene(s: &ElementSpec<'_>) -> Result<ArmScene, ModelError> {
             ))
         }
     };
+    // The spring parameters are read whatever the model, so that `--set` can switch
+    // `lumped_model` alone.
+    let stiffness = s.number_or("lumped_stiffness", f64::NAN)?;
+    let damping = s.number_or("lumped_damping", 0.0)?;
     scene.lumped_model = match s.string_or("lumped_model", "springs")?.as_str() {
         "springs" => {
             if scene.lumped_masses.is_empty() {
                 LumpedMassModel::Omitted
+            } else if stiffness.is_nan() {
+                return Err(bad(
+                    s,
+                    "lumped_model",
+                    "lumped masses on springs need `lumped_stiffness` (N/m)".into(),
+                ));
             } else {
-                LumpedMassModel::Springs {
-                    stiffness: s.number(
-                        "lumped_stiffness",
-                        "spring stiffness of the lumped masses, N/m",
-                    )?,
-                    damping: s.number_or("lumped_damping", 0.0)?,
-                }
+                LumpedMassModel::Springs { stiffness, damping }
             }
         }
         "rigid" => LumpedMassModel::Rigid,

@@ -18,7 +18,11 @@
 //! effort received), `T` (kinetic energy), and per link i (1-based): `x_e{i}`, `y_e{i}`, the
 //! end of its chord in frame 0 (for hinged–hinged modes the deformed end), and `w{i}_mid`,
 //! the deflection at mid-chord. Its states are `p[k]` and `q[k]`; the vector `<name>.q` is
-//! what the other fields read.
+//! what the other fields read. Each coordinate is also published by name, with its speed:
+//! `q1`, `u1`, … for the joints and `qb{i}_{k}`, `ub{i}_{k}` for the modes of link i
+//! (1-based, the design page's names); `qb{i}_{k}`/`ub{i}_{k}` exist for k = 1, 2, 3 even
+//! when link i has fewer modes (a mode that is not modelled has zero amplitude), so result
+//! columns survive a change of the number of modes.
 
 use std::cell::RefCell;
 use std::sync::Arc;
@@ -59,8 +63,29 @@ const OUT_U: usize = 0;
 const OUT_UDOT: usize = 1;
 const OUT_T: usize = 2;
 const OUT_LINKS: usize = 3;
+/// Named coordinates `qb{i}_{k}` are published at least up to this k.
+const NAMED_MODES: usize = 3;
 
 impl ArmInertia {
+    /// (coordinate name, speed name, index in q or `None` for an unmodelled mode).
+    fn named_coordinates(&self) -> Vec<(String, String, Option<usize>)> {
+        let mut v: Vec<(String, String, Option<usize>)> = (1..=self.arm.n_links())
+            .map(|i| (format!("q{i}"), format!("u{i}"), Some(i - 1)))
+            .collect();
+        for (i, l) in self.arm.links().iter().enumerate() {
+            let n_modes = l.modes().len();
+            for k in 1..=n_modes.max(NAMED_MODES) {
+                let index = (k <= n_modes).then(|| self.arm.modal_offset(i) + k - 1);
+                v.push((
+                    format!("qb{}_{k}", i + 1),
+                    format!("ub{}_{k}", i + 1),
+                    index,
+                ));
+            }
+        }
+        v
+    }
+
     /// The I-field of `arm` starting at configuration `q0` with speeds `u0` (p₀ = M(q₀)u₀).
     pub fn new(arm: Arc<PlanarArm>, q0: Vec<f64>, u0: Vec<f64>) -> Result<Self, ParamError> {
         let n = arm.n();
@@ -169,6 +194,7 @@ impl Element for ArmInertia {
     }
     fn signal_outputs(&self) -> Vec<SignalSpec> {
         let n = self.arm.n();
+        let named = self.named_coordinates();
         let mut out = vec![
             SignalSpec {
                 name: "u".into(),
@@ -185,10 +211,14 @@ impl Element for ArmInertia {
             out.push(SignalSpec::scalar(&format!("y_e{i}")));
             out.push(SignalSpec::scalar(&format!("w{i}_mid")));
         }
+        for (q, u, _) in &named {
+            out.push(SignalSpec::scalar(q));
+            out.push(SignalSpec::scalar(u));
+        }
         out
     }
     fn stages(&self, _: &[PortCausality]) -> Vec<Stage> {
-        let n_out = OUT_LINKS + 3 * self.arm.n_links();
+        let n_out = OUT_LINKS + 3 * self.arm.n_links() + 2 * self.named_coordinates().len();
         let mut writes = vec![Slot::Flow(0), Slot::Output(OUT_U), Slot::Output(OUT_T)];
         writes.extend((OUT_LINKS..n_out).map(Slot::Output));
         vec![
@@ -219,6 +249,12 @@ impl Element for ArmInertia {
                 io.set_y(OUT_LINKS + 3 * i, 0, end.x);
                 io.set_y(OUT_LINKS + 3 * i + 1, 0, end.y);
                 io.set_y(OUT_LINKS + 3 * i + 2, 0, w);
+            }
+            let first = OUT_LINKS + 3 * self.arm.n_links();
+            for (j, (_, _, index)) in self.named_coordinates().iter().enumerate() {
+                let (q, v) = index.map_or((0.0, 0.0), |k| (x[n + k], u[k]));
+                io.set_y(first + 2 * j, 0, q);
+                io.set_y(first + 2 * j + 1, 0, v);
             }
         } else {
             let e = DVector::from_column_slice(io.effort(0));

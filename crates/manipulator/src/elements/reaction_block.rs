@@ -94,10 +94,11 @@ impl ArmReactions {
         })
     }
 
-    /// Also publish `rho{k}_paper` (only with lumped masses on springs).
+    /// Also publish `rho{k}_paper`. Without lumped masses on springs (rigid or none) the
+    /// masses already move with their pins, so the two variants are the same.
     #[must_use]
     pub fn with_paper_variant(mut self, on: bool) -> Self {
-        self.paper = on && !self.springs.is_empty();
+        self.paper = on;
         self
     }
 
@@ -181,7 +182,11 @@ impl Element for ArmReactions {
             io.set_y(k, 0, *r);
         }
         if self.paper {
-            let paper = kin.reactions(&u, &udot, &loads[..n_act_loads], &self.springs);
+            let paper = if self.springs.is_empty() {
+                rho.clone()
+            } else {
+                kin.reactions(&u, &udot, &loads[..n_act_loads], &self.springs)
+            };
             for (k, r) in paper.iter().enumerate() {
                 io.set_y(self.n_rho() + k, 0, *r);
             }
