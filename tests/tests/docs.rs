@@ -1,5 +1,5 @@
-//! Every ```toml block of the documentation is a complete model that loads, runs and passes
-//! its checks, so the docs cannot drift from the format.
+//! Every ```toml block of the documentation (`docs/*.md`, README) is a complete model that
+//! loads, runs and passes its checks, so the docs cannot drift from the format.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use bg_tests::root;
@@ -24,7 +24,16 @@ fn toml_blocks(text: &str) -> Vec<String> {
 #[test]
 fn model_format_examples_load_and_run() {
     let mut n = 0;
-    for doc in ["docs/model-format.md", "README.md"] {
+    let mut docs: Vec<String> = std::fs::read_dir(root().join("docs"))
+        .unwrap()
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "md"))
+        .map(|p| format!("docs/{}", p.file_name().unwrap().to_string_lossy()))
+        .collect();
+    docs.sort();
+    docs.push("README.md".into());
+    for doc in &docs {
         let text = std::fs::read_to_string(root().join(doc)).unwrap();
         for (i, block) in toml_blocks(&text).into_iter().enumerate() {
             let name = format!("{doc} block {}", i + 1);
