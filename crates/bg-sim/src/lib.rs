@@ -4,6 +4,7 @@
 
 use bg_model::Registry;
 
+pub mod bench;
 pub mod plot;
 
 /// Every element kind this build knows: the core kinds plus the domain crates'.

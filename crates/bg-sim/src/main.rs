@@ -66,6 +66,30 @@ enum Command {
     },
     /// List the element kinds a model file can use.
     Kinds,
+    /// Measure the speed–accuracy trade: every solver at every rtol against a tight BDF
+    /// reference (wall time, steps, rhs evaluations, worst relative error of any column).
+    Bench {
+        /// The model file.
+        model: PathBuf,
+        /// Solvers, comma-separated.
+        #[arg(long, default_value = "bdf,esdirk34,tr-bdf2", value_delimiter = ',')]
+        solvers: Vec<String>,
+        /// Relative tolerances, comma-separated.
+        #[arg(long, default_value = "1e-4,1e-6,1e-8", value_delimiter = ',')]
+        rtols: Vec<f64>,
+        /// Relative tolerance of the BDF reference run.
+        #[arg(long, default_value_t = 1e-10)]
+        reference_rtol: f64,
+        /// Runs per configuration (the median wall time is reported).
+        #[arg(long, default_value_t = 3)]
+        repeat: usize,
+        /// End time (s), shorter than the model's for a quick look.
+        #[arg(long)]
+        t_end: Option<f64>,
+        /// Override a value of the model file (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+    },
     /// Draw the knuckle boom figures of the paper (Figs. 7-11, 15-18) from a results CSV as
     /// PNG; figures whose columns are missing are skipped.
     Plot {
@@ -119,6 +143,78 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Command::Plot { results, out } => plot(&results, &out, false),
+        Command::Bench {
+            model,
+            solvers,
+            rtols,
+            reference_rtol,
+            repeat,
+            t_end,
+            set,
+        } => bench(
+            &model,
+            &solvers,
+            &rtols,
+            reference_rtol,
+            repeat,
+            t_end,
+            &set,
+        ),
+    }
+}
+
+fn bench(
+    path: &Path,
+    solvers: &[String],
+    rtols: &[f64],
+    reference_rtol: f64,
+    repeat: usize,
+    t_end: Option<f64>,
+    set: &[String],
+) -> ExitCode {
+    let mut model = match Model::load(path, &registry(), set) {
+        Ok(m) => m,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let mut methods = Vec::new();
+    for s in solvers {
+        match Method::parse(s) {
+            Some(m) => methods.push(m),
+            None => {
+                eprintln!("error: unknown solver `{s}`\n  hint: solvers are bdf, esdirk34, tr-bdf2, tsit45");
+                return ExitCode::from(2);
+            }
+        }
+    }
+    if let Some(t) = t_end {
+        model.settings.t_end = t;
+    }
+    for &r in rtols.iter().chain(std::iter::once(&reference_rtol)) {
+        model.settings.rtol = r;
+        if let Err(e) = model.settings.validate() {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    }
+    println!(
+        "{}: {} states, 0 → {} s; reference bdf at rtol {reference_rtol:e}",
+        model.file(),
+        model.equations.n_states(),
+        model.settings.t_end
+    );
+    match bg_sim::bench::bench(&mut model, &methods, rtols, reference_rtol, repeat) {
+        Ok((reference, rows)) => {
+            println!("reference: {}", reference.stats);
+            print!("{}", bg_sim::bench::table(&rows));
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(1)
+        }
     }
 }
 
