@@ -491,6 +491,13 @@ impl StateEquations {
         &self.states
     }
 
+    /// Index in the state vector of element `id`'s local state `local`.
+    #[must_use]
+    pub fn state_index(&self, id: ElementId, local: usize) -> Option<usize> {
+        let l = self.layouts.get(id)?;
+        (local < l.n_states).then_some(l.state_offset + local)
+    }
+
     /// Initial state vector.
     #[must_use]
     pub fn initial_state(&self) -> Vec<f64> {

@@ -285,14 +285,11 @@ fn bounds(eqs: &StateEquations) -> Vec<Bound> {
     let mut v = Vec::new();
     for id in 0..eqs.graph().n_elements() {
         let node = eqs.graph().node(id);
-        let Some(first) = eqs.states().iter().position(|s| s.element == id) else {
-            continue;
-        };
         for l in node.element.limits() {
-            let index = first + l.state;
-            let Some(info) = eqs.states().get(index) else {
+            let Some(index) = eqs.state_index(id, l.state) else {
                 continue;
             };
+            let info = &eqs.states()[index];
             for (value, upper) in [(l.lower, false), (l.upper, true)] {
                 if value.is_finite() {
                     v.push(Bound {
@@ -321,14 +318,11 @@ fn watchers(eqs: &StateEquations) -> Vec<Watcher> {
     let mut v = Vec::new();
     for id in 0..eqs.graph().n_elements() {
         let node = eqs.graph().node(id);
-        let Some(first) = eqs.states().iter().position(|s| s.element == id) else {
-            continue;
-        };
         for w in node.element.watches() {
-            let index = first + w.state;
-            let Some(info) = eqs.states().get(index) else {
+            let Some(index) = eqs.state_index(id, w.state) else {
                 continue;
             };
+            let info = &eqs.states()[index];
             v.push(Watcher {
                 index,
                 report: WatchReport {

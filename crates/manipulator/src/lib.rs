@@ -62,8 +62,8 @@ pub mod stiffness;
 pub use actuator::LinearActuator;
 pub use arm::{PlanarArm, Pose, Station};
 pub use elements::{
-    ActuatorTransformer, ArmCompliance, ArmDamping, ArmInertia, ArmReactions, LumpedGravity,
-    LumpedMassTransformer, LumpedMasses,
+    lumped_masses, ActuatorTransformer, ArmCompliance, ArmDamping, ArmInertia, ArmReactions,
+    LumpedGravity, LumpedMassTransformer,
 };
 pub use error::ManipulatorError;
 pub use joint::RevoluteJoint;

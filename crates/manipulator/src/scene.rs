@@ -33,7 +33,7 @@ use crate::arm::PlanarArm;
 use crate::elements::ReactionInputs;
 use crate::elements::{
     ActuatorTransformer, ArmCompliance, ArmDamping, ArmInertia, ArmReactions, LumpedGravity,
-    LumpedMassTransformer, LumpedMasses,
+    LumpedMassTransformer,
 };
 use crate::error::ManipulatorError;
 use crate::link::{Link, PointMass};
@@ -198,7 +198,10 @@ impl ArmScene {
                 )
                 .element("damper", Resistor::new(damping)?)
                 .element("masses_j", OneJunction)
-                .element("masses", LumpedMasses::new(masses.clone(), v0.as_slice())?)
+                .element(
+                    "masses",
+                    crate::elements::lumped_masses(&masses, v0.as_slice())?,
+                )
                 .element("gravity", LumpedGravity::new(masses, self.gravity)?);
             c.bond("b_lump", "lump.1", "j")
                 .bond("b_pins", "pins", "lump.2")

@@ -349,6 +349,19 @@ impl ElementSpec<'_> {
         Ok(Param::modulated(inputs, move |_, u| compiled.eval(u)))
     }
 
+    /// Builders gather a law's inputs in a fixed buffer of `MAX_PARAM_INPUTS`.
+    fn check_input_count(&self, key: &str, n: usize) -> Result<(), ModelError> {
+        let max = bondgraph::element::MAX_PARAM_INPUTS;
+        if n > max {
+            return Err(self.error(
+                key,
+                ErrorKind::BadParameter,
+                format!("`{key}` reads {n} signals; at most {max}"),
+            ));
+        }
+        Ok(())
+    }
+
     /// Compile an expression: model parameters become constants, other names signal inputs.
     pub fn compile(&self, key: &str, e: &Expr) -> Result<(Compiled, Vec<String>), ModelError> {
         let mut inputs = Vec::new();
@@ -366,17 +379,7 @@ impl ElementSpec<'_> {
                     .hint(format!("define `{n}` in [parameters], or name a signal as `<element>.<variable>`; parameters: {}", self.constants.keys().cloned().collect::<Vec<_>>().join(", "))));
             }
         }
-        if inputs.len() > bondgraph::element::MAX_PARAM_INPUTS {
-            return Err(self.error(
-                key,
-                ErrorKind::BadParameter,
-                format!(
-                    "`{key}` reads {} signals; at most {}",
-                    inputs.len(),
-                    bondgraph::element::MAX_PARAM_INPUTS
-                ),
-            ));
-        }
+        self.check_input_count(key, inputs.len())?;
         let c = e
             .compile(&|n| self.constants.get(n).copied(), &inputs)
             .map_err(|m| self.error(key, ErrorKind::BadParameter, m))?;
@@ -464,17 +467,7 @@ impl ElementSpec<'_> {
                 }
             }
         }
-        if inputs.len() > bondgraph::element::MAX_PARAM_INPUTS {
-            return Err(self.error(
-                key,
-                ErrorKind::BadParameter,
-                format!(
-                    "`{key}` reads {} signals; at most {}",
-                    inputs.len(),
-                    bondgraph::element::MAX_PARAM_INPUTS
-                ),
-            ));
-        }
+        self.check_input_count(key, inputs.len())?;
         let compiled = exprs
             .iter()
             .map(|e| {

@@ -16,6 +16,8 @@ use crate::error::ParamError;
 #[derive(Debug)]
 pub struct Inertia {
     m: Param,
+    /// Per-component factors of `m` (all 1 unless built by [`Inertia::diagonal`]).
+    weights: Vec<f64>,
     p0: Vec<f64>,
 }
 
@@ -39,7 +41,28 @@ impl Inertia {
         for &p in &p0 {
             ParamError::finite("p0", p)?;
         }
-        Ok(Self { m, p0 })
+        Ok(Self {
+            m,
+            weights: vec![1.0; p0.len()],
+            p0,
+        })
+    }
+
+    /// An inertia with one mass per component (M = diag(masses), each > 0): point masses in
+    /// the plane, `masses = [m₁, m₁, m₂, m₂, …]`.
+    pub fn diagonal(masses: Vec<f64>, p0: Vec<f64>) -> Result<Self, ParamError> {
+        if masses.len() != p0.len() {
+            return Err(ParamError::Shape {
+                param: "masses".into(),
+                message: format!("{} masses for {} momenta", masses.len(), p0.len()),
+            });
+        }
+        for &w in &masses {
+            ParamError::positive("m", w)?;
+        }
+        let mut i = Self::multi(1.0, p0)?;
+        i.weights = masses;
+        Ok(i)
     }
 }
 
@@ -56,8 +79,8 @@ impl Element for Inertia {
     fn states(&self) -> Vec<StateSpec> {
         component_names("p", self.p0.len())
             .iter()
-            .zip(&self.p0)
-            .map(|(n, &p)| StateSpec::new(n, p).nominal(self.m.constant().unwrap_or(1.0)))
+            .zip(self.p0.iter().zip(&self.weights))
+            .map(|(n, (&p, &w))| StateSpec::new(n, p).nominal(self.m.constant().unwrap_or(1.0) * w))
             .collect()
     }
     fn signal_inputs(&self) -> Vec<SignalSpec> {
@@ -68,9 +91,9 @@ impl Element for Inertia {
     }
     fn eval(&self, _: usize, io: &mut Io<'_>) {
         let m = self.m.value(io, 0);
-        for k in 0..self.p0.len() {
+        for (k, w) in self.weights.iter().enumerate() {
             let p = io.states()[k];
-            io.set_f_in(0, k, p / m);
+            io.set_f_in(0, k, p / (m * w));
         }
     }
     fn derivatives(&self, io: &Io<'_>, dx: &mut [f64]) {
@@ -80,7 +103,12 @@ impl Element for Inertia {
     }
     fn stored_energy(&self, x: &[f64]) -> Option<f64> {
         let m = self.m.constant()?;
-        Some(x.iter().map(|p| p * p / (2.0 * m)).sum())
+        Some(
+            x.iter()
+                .zip(&self.weights)
+                .map(|(p, w)| p * p / (2.0 * m * w))
+                .sum(),
+        )
     }
 }
 
@@ -94,6 +122,16 @@ mod tests {
         assert!(Inertia::new(-2.0, 0.0).is_err());
         assert!(Inertia::new(f64::NAN, 0.0).is_err());
         assert!(Inertia::multi(1.0, vec![]).is_err());
+    }
+
+    #[test]
+    fn diagonal_masses_act_per_component() {
+        let i = Inertia::diagonal(vec![2.0, 4.0], vec![2.0, 2.0]).unwrap();
+        assert_eq!(i.stored_energy(&[2.0, 2.0]), Some(1.0 + 0.5));
+        let nominal: Vec<f64> = i.states().iter().map(|s| s.nominal).collect();
+        assert_eq!(nominal, [2.0, 4.0]);
+        assert!(Inertia::diagonal(vec![1.0], vec![0.0, 0.0]).is_err());
+        assert!(Inertia::diagonal(vec![1.0, 0.0], vec![0.0, 0.0]).is_err());
     }
 
     #[test]

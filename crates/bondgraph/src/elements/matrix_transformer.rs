@@ -19,6 +19,22 @@ use crate::error::ParamError;
 /// The modulus law: fill `t` (n₁×n₂) from time and the element's inputs.
 pub type ModulusLaw = Box<dyn Fn(&Io<'_>, &mut DMatrix<f64>)>;
 
+/// `e₁ = T·e₂` on ports 0 and 1 of `io` (for matrix MTFs of other crates too).
+pub fn apply_effort(io: &mut Io<'_>, t: &DMatrix<f64>) {
+    for i in 0..t.nrows() {
+        let e: f64 = (0..t.ncols()).map(|j| t[(i, j)] * io.e(1, j)).sum();
+        io.set_e(0, i, e);
+    }
+}
+
+/// `f_in₂ = −Tᵀ·f_in₁` on ports 0 and 1 of `io`.
+pub fn apply_flow(io: &mut Io<'_>, t: &DMatrix<f64>) {
+    for j in 0..t.ncols() {
+        let f: f64 = (0..t.nrows()).map(|i| t[(i, j)] * io.f_in(0, i)).sum();
+        io.set_f_in(1, j, -f);
+    }
+}
+
 /// Matrix MTF.
 pub struct MatrixTransformer {
     n1: usize,
@@ -112,15 +128,9 @@ impl Element for MatrixTransformer {
         let mut t = self.scratch.borrow_mut();
         (self.law)(io, &mut t);
         if stage == 0 {
-            for i in 0..self.n1 {
-                let e: f64 = (0..self.n2).map(|j| t[(i, j)] * io.e(1, j)).sum();
-                io.set_e(0, i, e);
-            }
+            apply_effort(io, &t);
         } else {
-            for j in 0..self.n2 {
-                let f: f64 = (0..self.n1).map(|i| t[(i, j)] * io.f_in(0, i)).sum();
-                io.set_f_in(1, j, -f);
-            }
+            apply_flow(io, &t);
         }
     }
 }

@@ -33,7 +33,7 @@ pub use gyrator::Gyrator;
 pub use inertia::Inertia;
 pub use junction::{OneJunction, ZeroJunction};
 pub use lag::Lag;
-pub use matrix_transformer::MatrixTransformer;
+pub use matrix_transformer::{apply_effort, apply_flow, MatrixTransformer};
 pub use p_controller::PController;
 pub use resistor::Resistor;
 pub use signal_function::SignalFunction;
@@ -41,7 +41,7 @@ pub use sources::{EffortSource, FlowSource};
 pub use transformer::Transformer;
 
 /// Names for the `n` components of a vector state: `p` for n = 1, else `p[0]`, `p[1]`, …
-pub(crate) fn component_names(base: &str, n: usize) -> Vec<String> {
+pub fn component_names(base: &str, n: usize) -> Vec<String> {
     if n == 1 {
         vec![base.to_owned()]
     } else {

@@ -33,9 +33,9 @@ use bondgraph::{
 };
 use nalgebra::{DMatrix, DVector};
 
-use super::component_names;
 use crate::arm::PlanarArm;
 use crate::kinetic_forces::solve;
+use bondgraph::component_names;
 
 /// The I-field of a [`PlanarArm`].
 #[derive(Debug)]

@@ -1,83 +1,50 @@
 //! The lumped cylinder masses (eq. 75): an I-field `ṗ = e`, `f_in = M_c⁻¹ p` with
-//! `M_c = diag(m₁ I₂, m₂ I₂, …)`, velocities in frame 0 (x then y per mass).
+//! `M_c = diag(m₁ I₂, m₂ I₂, …)`, velocities in frame 0 (x then y per mass). It is the core
+//! [`Inertia`] with one mass per component.
 
-use bondgraph::{
-    CausalRule, Element, Io, ParamError, PortCausality, PortSpec, Ports, Stage, StateSpec,
-};
+use bondgraph::{Inertia, ParamError};
 
-use super::component_names;
-
-/// Point masses moving in the plane.
-#[derive(Debug)]
-pub struct LumpedMasses {
-    masses: Vec<f64>,
-    p0: Vec<f64>,
+/// The lumped masses `masses` (kg, > 0), moving in the plane with initial velocities `v0`
+/// (x, y per mass; m/s): an [`Inertia`] on a 2m-bond.
+pub fn lumped_masses(masses: &[f64], v0: &[f64]) -> Result<Inertia, ParamError> {
+    if masses.is_empty() || v0.len() != 2 * masses.len() {
+        return Err(ParamError::Shape {
+            param: "lumped_masses".into(),
+            message: format!(
+                "{} masses need {} initial velocities, got {}",
+                masses.len(),
+                2 * masses.len(),
+                v0.len()
+            ),
+        });
+    }
+    let diagonal: Vec<f64> = masses.iter().flat_map(|&m| [m, m]).collect();
+    let p0 = v0.iter().zip(&diagonal).map(|(v, m)| m * v).collect();
+    Inertia::diagonal(diagonal, p0).map_err(|e| match e {
+        ParamError::OutOfRange {
+            value, requirement, ..
+        } => ParamError::OutOfRange {
+            param: "lumped mass".into(),
+            value,
+            requirement,
+        },
+        other => other,
+    })
 }
 
-impl LumpedMasses {
-    /// Masses `masses` (kg, > 0) with initial velocities `v0` (x, y per mass; m/s).
-    pub fn new(masses: Vec<f64>, v0: &[f64]) -> Result<Self, ParamError> {
-        if masses.is_empty() || v0.len() != 2 * masses.len() {
-            return Err(ParamError::Shape {
-                param: "lumped_masses".into(),
-                message: format!(
-                    "{} masses need {} initial velocities, got {}",
-                    masses.len(),
-                    2 * masses.len(),
-                    v0.len()
-                ),
-            });
-        }
-        for &m in &masses {
-            ParamError::positive("lumped mass", m)?;
-        }
-        let p0 = v0
-            .iter()
-            .enumerate()
-            .map(|(k, v)| masses[k / 2] * v)
-            .collect();
-        Ok(Self { masses, p0 })
-    }
-}
+#[cfg(test)]
+mod tests {
+    use bondgraph::Element;
 
-impl Element for LumpedMasses {
-    fn kind(&self) -> &str {
-        "manipulator.lumped_masses"
-    }
-    fn ports(&self) -> Ports {
-        Ports::Fixed(vec![PortSpec::new("1", self.p0.len())])
-    }
-    fn causal_rule(&self, _: usize) -> CausalRule {
-        CausalRule::Integral(vec![PortCausality::FlowOut])
-    }
-    fn states(&self) -> Vec<StateSpec> {
-        component_names("p", self.p0.len())
-            .iter()
-            .zip(&self.p0)
-            .enumerate()
-            .map(|(k, (n, &p))| StateSpec::new(n, p).nominal(self.masses[k / 2]))
-            .collect()
-    }
-    fn stages(&self, causality: &[PortCausality]) -> Vec<Stage> {
-        Stage::from_states(causality, 0, 0)
-    }
-    fn eval(&self, _: usize, io: &mut Io<'_>) {
-        for k in 0..self.p0.len() {
-            let v = io.states()[k] / self.masses[k / 2];
-            io.set_f_in(0, k, v);
-        }
-    }
-    fn derivatives(&self, io: &Io<'_>, dx: &mut [f64]) {
-        for (k, d) in dx.iter_mut().enumerate() {
-            *d = io.e(0, k);
-        }
-    }
-    fn stored_energy(&self, x: &[f64]) -> Option<f64> {
-        Some(
-            x.iter()
-                .enumerate()
-                .map(|(k, p)| p * p / (2.0 * self.masses[k / 2]))
-                .sum(),
-        )
+    use super::*;
+
+    #[test]
+    fn one_mass_per_pair_of_components() {
+        let m = lumped_masses(&[2.0, 4.0], &[1.0, 0.0, 0.0, 0.5]).unwrap();
+        let p0: Vec<f64> = m.states().iter().map(|s| s.initial).collect();
+        assert_eq!(p0, [2.0, 0.0, 0.0, 2.0]);
+        assert_eq!(m.stored_energy(&p0), Some(1.0 + 0.5));
+        assert!(lumped_masses(&[1.0], &[0.0]).is_err());
+        assert!(lumped_masses(&[-1.0], &[0.0, 0.0]).is_err());
     }
 }

@@ -7,7 +7,7 @@
 //! | `manipulator.r_field` | [`ArmDamping`] | `1`: n | e = D f_in, D diagonal |
 //! | `manipulator.actuator_mtf` | [`ActuatorTransformer`] | `1`: n, `2`: n_act | e₁ = τ_b e₂, f_in₂ = −τ_bᵀ f_in₁ (eq. 66) |
 //! | `manipulator.lumped_mass_mtf` | [`LumpedMassTransformer`] | `1`: n, `2`: 2m | e₁ = J_cᵀ e₂, f_in₂ = −J_c f_in₁ (eq. 70) |
-//! | `manipulator.lumped_masses` | [`LumpedMasses`] | `1`: 2m | ṗ = e, f_in = M_c⁻¹ p (eq. 75) |
+//! | `I` (diagonal) | [`lumped_masses`] | `1`: 2m | ṗ = e, f_in = M_c⁻¹ p (eq. 75) |
 //! | `manipulator.lumped_gravity` | [`LumpedGravity`] | `1`: 2m | e = −g [0 m₁ 0 m₂ …] (eq. 76) |
 //! | `manipulator.reactions` | [`ArmReactions`] | — | publishes ρ (eqs. 84–98) |
 //!
@@ -31,15 +31,6 @@ pub use c_field::ArmCompliance;
 pub use i_field::ArmInertia;
 pub use lumped_gravity::LumpedGravity;
 pub use lumped_mass_mtf::LumpedMassTransformer;
-pub use lumped_masses::LumpedMasses;
+pub use lumped_masses::lumped_masses;
 pub use r_field::ArmDamping;
 pub use reaction_block::{ArmReactions, ReactionInputs};
-
-/// Names `base[0]..base[n-1]` (or `base` if n = 1) of a vector state.
-pub(crate) fn component_names(base: &str, n: usize) -> Vec<String> {
-    if n == 1 {
-        vec![base.to_owned()]
-    } else {
-        (0..n).map(|k| format!("{base}[{k}]")).collect()
-    }
-}

@@ -24,16 +24,10 @@ pub(crate) fn stages(flow_outputs: &[usize]) -> Vec<Stage> {
 
 /// `e₁ = T e₂`.
 pub(crate) fn set_effort(io: &mut Io<'_>, t: &DMatrix<f64>) {
-    for i in 0..t.nrows() {
-        let e: f64 = (0..t.ncols()).map(|j| t[(i, j)] * io.e(1, j)).sum();
-        io.set_e(0, i, e);
-    }
+    bondgraph::apply_effort(io, t);
 }
 
 /// `f_in₂ = −Tᵀ f_in₁`.
 pub(crate) fn set_flow(io: &mut Io<'_>, t: &DMatrix<f64>) {
-    for j in 0..t.ncols() {
-        let f: f64 = (0..t.nrows()).map(|i| t[(i, j)] * io.f_in(0, i)).sum();
-        io.set_f_in(1, j, -f);
-    }
+    bondgraph::apply_flow(io, t);
 }
