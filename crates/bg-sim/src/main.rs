@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use bg_model::{inspect, Model};
-use bg_sim::plot::{plot_all, Drawn, Results};
+use bg_sim::plot::{plot_all, work_precision, Drawn, Results, WorkPrecisionLine};
 use bg_sim::registry;
 use bondgraph::{Method, Outcome};
 use clap::{Parser, Subcommand};
@@ -66,8 +66,8 @@ enum Command {
     },
     /// List the element kinds a model file can use.
     Kinds,
-    /// Measure the speed–accuracy trade: every solver at every rtol against a tight BDF
-    /// reference (wall time, steps, rhs evaluations, worst relative error of any column).
+    /// Measure the speed–accuracy trade: every solver at every rtol against a reference
+    /// (wall time, steps, rhs evaluations, the worst scaled error of the scored columns).
     Bench {
         /// The model file.
         model: PathBuf,
@@ -77,9 +77,27 @@ enum Command {
         /// Relative tolerances, comma-separated.
         #[arg(long, default_value = "1e-4,1e-6,1e-8", value_delimiter = ',')]
         rtols: Vec<f64>,
-        /// Relative tolerance of the BDF reference run.
+        /// A results CSV to score against (e.g. `bg-sim run --rtol 1e-10`); without it, a
+        /// BDF run at --reference-rtol is the reference.
+        #[arg(long, value_name = "REF.csv")]
+        reference: Option<PathBuf>,
+        /// Relative tolerance of the reference run (when no --reference is given).
         #[arg(long, default_value_t = 1e-10)]
         reference_rtol: f64,
+        /// Columns to score, comma-separated (default: every column of the reference).
+        #[arg(long, value_delimiter = ',')]
+        columns: Option<Vec<String>>,
+        /// Error floor of the columns matching PATTERN (`*` matches any text), repeatable:
+        /// --floor 'qb*=1e-3'. By default a column's floor is 1 % of the largest scale among
+        /// the columns of its quantity.
+        #[arg(long = "floor", value_name = "PATTERN=VALUE")]
+        floors: Vec<String>,
+        /// Also draw the work–precision diagram (error vs wall time per method) as PNG.
+        #[arg(long, value_name = "FILE.png")]
+        plot: Option<PathBuf>,
+        /// Only time the right-hand side (µs per call) and the Jacobian; no runs.
+        #[arg(long)]
+        rhs: bool,
         /// Runs per configuration (the median wall time is reported).
         #[arg(long, default_value_t = 3)]
         repeat: usize,
@@ -147,68 +165,165 @@ fn main() -> ExitCode {
             model,
             solvers,
             rtols,
+            reference,
             reference_rtol,
+            columns,
+            floors,
+            plot,
+            rhs,
             repeat,
             t_end,
             set,
-        } => bench(
-            &model,
-            &solvers,
-            &rtols,
+        } => bench(&BenchArgs {
+            path: &model,
+            solvers: &solvers,
+            rtols: &rtols,
+            reference: reference.as_deref(),
             reference_rtol,
+            columns: columns.as_deref(),
+            floors: &floors,
+            plot: plot.as_deref(),
+            rhs_only: rhs,
             repeat,
             t_end,
-            &set,
-        ),
+            set: &set,
+        }),
     }
 }
 
-fn bench(
-    path: &Path,
-    solvers: &[String],
-    rtols: &[f64],
+struct BenchArgs<'a> {
+    path: &'a Path,
+    solvers: &'a [String],
+    rtols: &'a [f64],
+    reference: Option<&'a Path>,
     reference_rtol: f64,
+    columns: Option<&'a [String]>,
+    floors: &'a [String],
+    plot: Option<&'a Path>,
+    rhs_only: bool,
     repeat: usize,
     t_end: Option<f64>,
-    set: &[String],
-) -> ExitCode {
-    let mut model = match Model::load(path, &registry(), set) {
+    set: &'a [String],
+}
+
+fn bench(a: &BenchArgs<'_>) -> ExitCode {
+    use bg_sim::bench::{bench, reference_run, rhs_cost, table, Reference};
+    let mut model = match Model::load(a.path, &registry(), a.set) {
         Ok(m) => m,
         Err(e) => {
             eprintln!("error: {e}");
             return ExitCode::from(2);
         }
     };
+    if a.rhs_only {
+        let c = rhs_cost(&model, 20_000);
+        println!(
+            "{}: {} states; rhs {:.3} µs per call (median of 7 × 20 000 calls)",
+            model.file(),
+            c.n,
+            c.rhs_us
+        );
+        return ExitCode::SUCCESS;
+    }
     let mut methods = Vec::new();
-    for s in solvers {
+    for s in a.solvers {
         match Method::parse(s) {
             Some(m) => methods.push(m),
             None => {
-                eprintln!("error: unknown solver `{s}`\n  hint: solvers are bdf, esdirk34, tr-bdf2, tsit45");
+                eprintln!(
+                    "error: unknown solver `{s}`\n  hint: solvers are {}",
+                    Method::ALL.map(Method::name).join(", ")
+                );
                 return ExitCode::from(2);
             }
         }
     }
-    if let Some(t) = t_end {
+    let mut floors = Vec::new();
+    for f in a.floors {
+        match f
+            .split_once('=')
+            .map(|(p, v)| (p.trim(), v.trim().parse::<f64>()))
+        {
+            Some((p, Ok(v))) if !p.is_empty() && v.is_finite() && v >= 0.0 => {
+                floors.push((p.to_owned(), v));
+            }
+            _ => {
+                eprintln!("error: --floor `{f}`: expected PATTERN=VALUE with a finite VALUE ≥ 0\n  hint: --floor 'qb*=1e-3'");
+                return ExitCode::from(2);
+            }
+        }
+    }
+    if let Some(t) = a.t_end {
         model.settings.t_end = t;
     }
-    for &r in rtols.iter().chain(std::iter::once(&reference_rtol)) {
+    for &r in a.rtols.iter().chain(std::iter::once(&a.reference_rtol)) {
         model.settings.rtol = r;
         if let Err(e) = model.settings.validate() {
             eprintln!("error: {e}");
             return ExitCode::from(2);
         }
     }
+    let reference = match a.reference {
+        Some(p) => Reference::read(p, a.columns, &floors).map(|r| (format!("{}", p.display()), r)),
+        None => reference_run(
+            &mut model,
+            Method::Bdf,
+            a.reference_rtol,
+            a.columns,
+            &floors,
+        )
+        .map(|(o, r)| {
+            (
+                format!("bdf at rtol {:e}: {}", a.reference_rtol, o.stats),
+                r,
+            )
+        }),
+    };
+    let (what, reference) = match reference {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
     println!(
-        "{}: {} states, 0 → {} s; reference bdf at rtol {reference_rtol:e}",
+        "{}: {} states, 0 → {} s; reference {what}; {} columns scored",
         model.file(),
         model.equations.n_states(),
-        model.settings.t_end
+        model.settings.t_end,
+        reference.columns.len()
     );
-    match bg_sim::bench::bench(&mut model, &methods, rtols, reference_rtol, repeat) {
-        Ok((reference, rows)) => {
-            println!("reference: {}", reference.stats);
-            print!("{}", bg_sim::bench::table(&rows));
+    match bench(&mut model, &methods, a.rtols, &reference, a.repeat) {
+        Ok(rows) => {
+            print!("{}", table(&rows));
+            if let Some(png) = a.plot {
+                let lines: Vec<WorkPrecisionLine> = methods
+                    .iter()
+                    .map(|m| WorkPrecisionLine {
+                        label: m.name().to_owned(),
+                        points: rows
+                            .iter()
+                            .filter(|r| r.method == *m)
+                            .filter_map(|r| {
+                                r.error
+                                    .as_ref()
+                                    .map(|(e, _)| (r.wall.as_secs_f64() * 1e3, *e))
+                            })
+                            .collect(),
+                    })
+                    .collect();
+                let title = format!(
+                    "{}: work–precision",
+                    model.title.as_deref().unwrap_or(model.file())
+                );
+                match work_precision(&title, &lines, png) {
+                    Ok(p) => println!("wrote {}", p.display()),
+                    Err(e) => {
+                        eprintln!("error: {e}");
+                        return ExitCode::from(1);
+                    }
+                }
+            }
             ExitCode::SUCCESS
         }
         Err(e) => {
