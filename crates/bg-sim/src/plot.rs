@@ -575,7 +575,8 @@ pub fn work_precision(
             .label_style((FONT, 14))
             .axis_desc_style((FONT, 15))
             .y_label_formatter(&|v| format!("{v:.0e}"))
-            .light_line_style(RGBColor(238, 238, 238))
+            .x_label_formatter(&|v| significant(*v))
+            .light_line_style(RGBColor(245, 245, 245))
             .draw()
             .map_err(|e| fail(&e))?;
         for (i, line) in lines.iter().enumerate() {
@@ -605,6 +606,20 @@ pub fn work_precision(
         root.present().map_err(|e| fail(&e))?;
     }
     Ok(path.to_path_buf())
+}
+
+/// A tick label with three significant digits and no trailing zeros (0.3, 12, 0.0025).
+fn significant(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let digits = (2 - v.abs().log10().floor() as i32).max(0) as usize;
+    let s = format!("{v:.digits$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_owned()
+    } else {
+        s
+    }
 }
 
 const PALETTE: [RGBColor; 6] = [
