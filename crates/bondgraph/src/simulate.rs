@@ -663,7 +663,9 @@ fn run_segment(
     problem.ode_options.max_nonlinear_solver_failures = 10_000;
     problem.ode_options.max_error_test_failures = 100;
     let result = match settings.method {
-        Method::Bdf => problem.bdf::<LS>().map(|s| Box::new(Diffsol::new(s)) as Box<dyn Stepper + '_>),
+        Method::Bdf => problem
+            .bdf::<LS>()
+            .map(|s| Box::new(Diffsol::new(s)) as Box<dyn Stepper + '_>),
         Method::Esdirk34 => problem
             .esdirk34::<LS>()
             .map(|s| Box::new(Diffsol::new(s)) as Box<dyn Stepper + '_>),
@@ -677,7 +679,15 @@ fn run_segment(
     .map_err(|e| e.to_string())
     .and_then(|mut s| {
         s.set_stop_time(t_stop)?;
-        Ok(drive(s.as_mut(), rec, t_stop, settings.max_steps, &limits, &bad, stats))
+        Ok(drive(
+            s.as_mut(),
+            rec,
+            t_stop,
+            settings.max_steps,
+            &limits,
+            &bad,
+            stats,
+        ))
     });
     stats.rhs_evals += rhs_calls.get();
     stats.jac_rhs_evals += jac_calls.get();
