@@ -108,6 +108,20 @@ enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
     },
+    /// Compare a results CSV with a reference CSV, column by column, with the scaled error
+    /// of `bench` (|run − reference| / max(range, |mean|, quantity floor)).
+    Compare {
+        /// The results to score.
+        results: PathBuf,
+        /// The reference results (same time span).
+        reference: PathBuf,
+        /// Columns to score, comma-separated (default: every column of the reference).
+        #[arg(long, value_delimiter = ',')]
+        columns: Option<Vec<String>>,
+        /// Error floor of the columns matching PATTERN, repeatable (as for `bench`).
+        #[arg(long = "floor", value_name = "PATTERN=VALUE")]
+        floors: Vec<String>,
+    },
     /// Draw the knuckle boom figures of the paper (Figs. 7-11, 15-18) from a results CSV as
     /// PNG; figures whose columns are missing are skipped.
     Plot {
@@ -161,6 +175,12 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Command::Plot { results, out } => plot(&results, &out, false),
+        Command::Compare {
+            results,
+            reference,
+            columns,
+            floors,
+        } => compare(&results, &reference, columns.as_deref(), &floors),
         Command::Bench {
             model,
             solvers,
@@ -329,6 +349,66 @@ fn bench(a: &BenchArgs<'_>) -> ExitCode {
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::from(1)
+        }
+    }
+}
+
+/// `--floor PATTERN=VALUE` arguments, or `None` after printing why one is refused.
+fn parse_floors(args: &[String]) -> Option<Vec<(String, f64)>> {
+    let mut floors = Vec::new();
+    for f in args {
+        match f
+            .split_once('=')
+            .map(|(p, v)| (p.trim(), v.trim().parse::<f64>()))
+        {
+            Some((p, Ok(v))) if !p.is_empty() && v.is_finite() && v >= 0.0 => {
+                floors.push((p.to_owned(), v));
+            }
+            _ => {
+                eprintln!("error: --floor `{f}`: expected PATTERN=VALUE with a finite VALUE ≥ 0\n  hint: --floor 'qb*=1e-3'");
+                return None;
+            }
+        }
+    }
+    Some(floors)
+}
+
+fn compare(
+    results: &Path,
+    reference: &Path,
+    columns: Option<&[String]>,
+    floors: &[String],
+) -> ExitCode {
+    let Some(floors) = parse_floors(floors) else {
+        return ExitCode::from(2);
+    };
+    let scored = bg_sim::bench::Reference::read(reference, columns, &floors).and_then(|r| {
+        let run = Results::read(results)
+            .map_err(|e| e.to_string())?
+            .to_trajectory();
+        let errors = r.errors(&run).ok_or_else(|| {
+            format!(
+                "{} does not cover the time span of {} or lacks one of its columns",
+                results.display(),
+                reference.display()
+            )
+        })?;
+        Ok((r, errors))
+    });
+    match scored {
+        Ok((r, errors)) => {
+            println!("| column | scale | scaled error |\n|---|---|---|");
+            for ((name, e), (_, _, scale)) in errors.iter().zip(&r.columns) {
+                println!("| {name} | {scale:.4e} | {e:.3e} |");
+            }
+            if let Some((name, e)) = errors.iter().max_by(|a, b| a.1.total_cmp(&b.1)) {
+                println!("worst: {name} {e:.3e}");
+            }
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
         }
     }
 }

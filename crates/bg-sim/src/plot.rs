@@ -139,6 +139,18 @@ impl Results {
         &self.names
     }
 
+    /// The table as a [`Trajectory`](bondgraph::Trajectory) (rows of values, `t` first).
+    #[must_use]
+    pub fn to_trajectory(&self) -> bondgraph::Trajectory {
+        let n = self.columns[0].len();
+        bondgraph::Trajectory {
+            columns: self.names.clone(),
+            rows: (0..n)
+                .map(|i| self.columns.iter().map(|c| c[i]).collect())
+                .collect(),
+        }
+    }
+
     /// The time column.
     #[must_use]
     pub fn time(&self) -> &[f64] {
