@@ -112,7 +112,7 @@ impl Reference {
             None => named,
             Some(list) => {
                 let mut v = Vec::new();
-                for c in list {
+                for c in list.iter().filter(|c| c.as_str() != "t") {
                     let Some((_, vals)) = named.iter().find(|(n, _)| n == c) else {
                         let have: Vec<&str> =
                             named.iter().map(|(n, _)| n.as_str()).take(20).collect();
