@@ -252,7 +252,7 @@ fn bench(a: &BenchArgs<'_>) -> ExitCode {
             None => {
                 eprintln!(
                     "error: unknown solver `{s}`\n  hint: solvers are {}",
-                    Method::ALL.map(Method::name).join(", ")
+                    Method::names()
                 );
                 return ExitCode::from(2);
             }
@@ -472,7 +472,10 @@ fn run(
         match Method::parse(s) {
             Some(m) => model.settings.method = m,
             None => {
-                eprintln!("error: unknown solver `{s}`\n  hint: solvers are bdf, esdirk34, tr-bdf2, tsit45");
+                eprintln!(
+                    "error: unknown solver `{s}`\n  hint: solvers are {}",
+                    Method::names()
+                );
                 return (ExitCode::from(2), None);
             }
         }

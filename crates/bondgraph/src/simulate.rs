@@ -66,6 +66,11 @@ impl Method {
             Self::Tsit45 => "tsit45",
         }
     }
+    /// The names `parse` accepts, for hints: `bdf, esdirk34, …`.
+    #[must_use]
+    pub fn names() -> String {
+        Self::ALL.map(Self::name).join(", ")
+    }
     /// All methods.
     pub const ALL: [Method; 4] = [
         Method::Bdf,

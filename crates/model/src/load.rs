@@ -941,7 +941,7 @@ fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
                     Some(&s.span()),
                     format!("unknown solver `{}`", s.get_ref()),
                 )
-                .hint("solvers: bdf, esdirk34, tr-bdf2, tsit45")
+                .hint(format!("solvers: {}", Method::names()))
         })?;
     }
     if let Err(e) = settings.validate() {
