@@ -45,7 +45,8 @@
 //! ## Simulation
 //! [`simulate`] integrates with diffsol ([`Method`]: BDF, ESDIRK34, TR-BDF2, Tsit45), with
 //! output times, scheduled [`Event`]s and [`Statistics`], and keeps the rows computed when it
-//! fails.
+//! fails. [`radau`] is a standalone Radau IIA (order 5) integrator: [`Radau5`] over an
+//! [`OdeSystem`], stepped towards stop times, with dense output and restarts.
 
 pub mod bond;
 pub mod causality;
@@ -54,6 +55,7 @@ pub mod elements;
 pub mod equations;
 pub mod error;
 pub mod graph;
+pub mod radau;
 pub mod simulate;
 
 pub use bond::{Bond, BondId, ElementId, Endpoint, PortCausality};
@@ -66,6 +68,7 @@ pub use elements::*;
 pub use equations::{Probe, StateEquations, StateInfo};
 pub use error::{CausalityError, Error, GraphError, ParamError, SimulationError};
 pub use graph::{BondGraph, Node};
+pub use radau::{OdeSystem, Radau5, RadauError, RadauOptions, RadauStats, StepReport};
 pub use simulate::{
     simulate, Event, Method, Outcome, Output, Settings, Statistics, Trajectory, WatchReport,
 };
