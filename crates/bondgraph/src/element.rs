@@ -8,6 +8,7 @@
 use std::fmt::Debug;
 
 use crate::bond::PortCausality;
+use crate::local_jacobian::LocalJacobian;
 
 /// Port signature of an element.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -199,7 +200,9 @@ impl Stage {
 ///
 /// Only [`kind`](Element::kind), [`ports`](Element::ports), [`causal_rule`](Element::causal_rule)
 /// and [`eval`](Element::eval) are required. Storage elements add [`states`](Element::states),
-/// [`derivatives`](Element::derivatives) and usually [`stages`](Element::stages).
+/// [`derivatives`](Element::derivatives) and usually [`stages`](Element::stages). Elements that
+/// know their partial derivatives say them in [`stage_partials`](Element::stage_partials) and
+/// [`derivative_partials`](Element::derivative_partials) (else the Jacobian differences them).
 pub trait Element: Debug {
     /// Kind as written in model files: `"R"`, `"0"`, `"hydraulics.orifice"`.
     fn kind(&self) -> &str;
@@ -241,6 +244,27 @@ pub trait Element: Debug {
     /// State derivatives `dx` (this element's slice), once every variable is known.
     fn derivatives(&self, io: &Io<'_>, dx: &mut [f64]) {
         let _ = (io, dx);
+    }
+
+    /// Partial derivatives of the scalars `stage` writes with respect to the element's local
+    /// variables (see [`LocalJacobian`] for the rows, columns and sign conventions).
+    ///
+    /// `io` holds the values at the evaluation point, including the stage's own writes; `jac`
+    /// arrives zeroed. Return `true` if the entries are filled, `false` (the default) to let
+    /// the core difference `eval` locally instead. Entries are exact derivatives where
+    /// the law is smooth; at a kink (a clamp, an absolute value) either one-sided value.
+    fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        let _ = (stage, io, jac);
+        false
+    }
+
+    /// Partial derivatives of the element's state derivatives (rows: its states, in order)
+    /// with respect to its local variables (see [`LocalJacobian`]), after every variable is
+    /// known. `jac` arrives zeroed. Return `true` if the entries are filled, `false` (the
+    /// default) to let the core difference [`derivatives`](Element::derivatives) locally.
+    fn derivative_partials(&self, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        let _ = (io, jac);
+        false
     }
 
     /// States the simulator should watch over a run, every accepted step (a chamber's
