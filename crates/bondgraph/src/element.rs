@@ -528,6 +528,48 @@ impl Param {
             }
         }
     }
+
+    /// Partial derivatives of the value with respect to its inputs (the element's inputs
+    /// `first..first + n_inputs`), into `grad[..n_inputs]`; nothing for a constant.
+    ///
+    /// A law is a closure, so the derivatives are central differences of the law alone
+    /// (step ∛ε·max(|u|, 1e-3); error about 1e-10 relative for smooth laws): cheap, and
+    /// free of allocation for up to [`MAX_PARAM_INPUTS`] inputs.
+    pub fn gradient(&self, io: &Io<'_>, first: usize, grad: &mut [f64]) {
+        let Self::Modulated { inputs, law } = self else {
+            return;
+        };
+        let n = inputs.len();
+        let mut small = [0.0; MAX_PARAM_INPUTS];
+        let mut large = Vec::new();
+        let u: &mut [f64] = if n > MAX_PARAM_INPUTS {
+            large.resize(n, 0.0);
+            &mut large
+        } else {
+            &mut small[..n]
+        };
+        for (k, b) in u.iter_mut().enumerate() {
+            *b = io.u(first + k);
+        }
+        let t = io.time();
+        for (k, g) in grad.iter_mut().take(n).enumerate() {
+            let v = u[k];
+            let h = central_step(v, 1e-3);
+            u[k] = v + h;
+            let plus = law(t, u);
+            u[k] = v - h;
+            let minus = law(t, u);
+            u[k] = v;
+            *g = (plus - minus) / (2.0 * h);
+        }
+    }
+}
+
+/// The step of a central difference at `v`: ∛ε·max(|v|, `floor`), rounded so that v ± h are
+/// exact.
+pub(crate) fn central_step(v: f64, floor: f64) -> f64 {
+    let h = 6.055_454_452_393_343e-6 * v.abs().max(floor);
+    (v + h) - v
 }
 
 impl Debug for Param {

@@ -68,6 +68,8 @@ pub use equations::{Probe, StateEquations, StateInfo};
 pub use error::{CausalityError, Error, GraphError, ParamError, SimulationError};
 pub use graph::{BondGraph, Node};
 pub use local_jacobian::{LocalJacobian, LocalShape};
+/// The dense matrix type of [`StateEquations::jacobian`].
+pub use nalgebra::DMatrix;
 pub use simulate::{
     simulate, Event, Method, Outcome, Output, Settings, Statistics, Trajectory, WatchReport,
 };
