@@ -55,6 +55,7 @@ pub mod elements;
 pub mod equations;
 pub mod error;
 pub mod graph;
+pub mod local_jacobian;
 pub mod radau;
 pub mod simulate;
 
@@ -68,6 +69,9 @@ pub use elements::*;
 pub use equations::{Probe, StateEquations, StateInfo};
 pub use error::{CausalityError, Error, GraphError, ParamError, SimulationError};
 pub use graph::{BondGraph, Node};
+pub use local_jacobian::{LocalJacobian, LocalShape};
+/// The dense matrix type of [`StateEquations::jacobian`].
+pub use nalgebra::DMatrix;
 pub use radau::{OdeSystem, Radau5, RadauError, RadauOptions, RadauStats, StepReport};
 pub use simulate::{
     simulate, Event, Method, Outcome, Output, Settings, Statistics, Trajectory, WatchReport,
