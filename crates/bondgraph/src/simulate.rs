@@ -26,6 +26,7 @@ use crate::bond::ElementId;
 use crate::element::Element;
 use crate::equations::{Probe, StateEquations};
 use crate::error::SimulationError;
+use crate::radau::{OdeSystem, Radau5, RadauOptions};
 
 type M = NalgebraMat<f64>;
 type LS = NalgebraLU<f64>;
@@ -42,6 +43,9 @@ pub enum Method {
     TrBdf2,
     /// Tsitouras 5(4), explicit: only for non-stiff models.
     Tsit45,
+    /// Radau IIA, order 5 (3-stage, L-stable): for stiff systems with lightly damped
+    /// oscillations (see [`radau`](crate::radau)).
+    Radau5,
 }
 
 impl Method {
@@ -53,6 +57,7 @@ impl Method {
             "esdirk34" | "esdirk" => Some(Self::Esdirk34),
             "tr-bdf2" | "trbdf2" => Some(Self::TrBdf2),
             "tsit45" | "tsit5" => Some(Self::Tsit45),
+            "radau5" | "radau" => Some(Self::Radau5),
             _ => None,
         }
     }
@@ -64,6 +69,7 @@ impl Method {
             Self::Esdirk34 => "esdirk34",
             Self::TrBdf2 => "tr-bdf2",
             Self::Tsit45 => "tsit45",
+            Self::Radau5 => "radau5",
         }
     }
     /// The names `parse` accepts, for hints: `bdf, esdirk34, …`.
@@ -72,11 +78,12 @@ impl Method {
         Self::ALL.map(Self::name).join(", ")
     }
     /// All methods.
-    pub const ALL: [Method; 4] = [
+    pub const ALL: [Method; 5] = [
         Method::Bdf,
         Method::Esdirk34,
         Method::TrBdf2,
         Method::Tsit45,
+        Method::Radau5,
     ];
 }
 
@@ -641,6 +648,11 @@ fn run_segment(
     }
     let x0 = x.to_vec();
     let limits = bounds(eqs);
+    if settings.method == Method::Radau5 {
+        return run_radau(
+            rec, settings, t, t_stop, x, &atol, &nominal, limits, &bad, stats,
+        );
+    }
     let n_roots = limits.len();
     let roots_of = limits.clone();
     let problem = OdeBuilder::<M>::new()
@@ -680,6 +692,9 @@ fn run_segment(
         Method::Tsit45 => problem
             .tsit45()
             .map(|s| Box::new(Diffsol::new(s)) as Box<dyn Stepper + '_>),
+        Method::Radau5 => Err(diffsol::error::DiffsolError::Other(
+            "radau5 is not a diffsol method".into(),
+        )),
     }
     .map_err(|e| e.to_string())
     .and_then(|mut s| {
@@ -922,4 +937,196 @@ fn drive(
             return Ok(x);
         }
     }
+}
+
+/// The equations as the Radau integrator sees them: calls counted, the first non-finite
+/// derivative noted for the error report.
+struct RadauEquations<'e> {
+    eqs: &'e StateEquations,
+    nominal: &'e [f64],
+    bad: &'e RefCell<Option<(f64, Vec<f64>)>>,
+    rhs_calls: usize,
+    jac_rhs_calls: usize,
+    xp: Vec<f64>,
+    fxp: Vec<f64>,
+}
+
+impl OdeSystem for RadauEquations<'_> {
+    fn n(&self) -> usize {
+        self.eqs.n_states()
+    }
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) {
+        self.rhs_calls += 1;
+        self.eqs.rhs(t, y, dy);
+        if self.bad.borrow().is_none() && dy.iter().any(|v| !v.is_finite()) {
+            *self.bad.borrow_mut() = Some((t, y.to_vec()));
+        }
+    }
+    fn jacobian(&mut self, t: f64, y: &[f64], fy: &[f64], jac: &mut nalgebra::DMatrix<f64>) {
+        // Forward differences, one column per state.
+        self.xp.copy_from_slice(y);
+        for j in 0..y.len() {
+            let sigma = f64::EPSILON.sqrt() * y[j].abs().max(self.nominal[j]);
+            self.xp[j] = y[j] + sigma;
+            self.eqs.rhs(t, &self.xp, &mut self.fxp);
+            self.jac_rhs_calls += 1;
+            for (i, (a, b)) in self.fxp.iter().zip(fy).enumerate() {
+                jac[(i, j)] = (a - b) / sigma;
+            }
+            self.xp[j] = y[j];
+        }
+    }
+}
+
+/// [`Radau5`] as a [`Stepper`]: limits are located inside each step by bisection on the
+/// dense output.
+struct RadauStepper<'e> {
+    radau: Radau5,
+    sys: RadauEquations<'e>,
+    t_stop: f64,
+    limits: Vec<Bound>,
+}
+
+impl RadauStepper<'_> {
+    /// The earliest crossing of a limit inside the last step, if any.
+    fn crossing(&self) -> Option<(f64, usize)> {
+        let (t0, t1) = (self.radau.t_prev(), self.radau.t());
+        let mut y = vec![0.0; self.radau.y().len()];
+        let mut first: Option<(f64, usize)> = None;
+        for (k, b) in self.limits.iter().enumerate() {
+            if b.margin(self.radau.y()) >= 0.0 {
+                continue;
+            }
+            // margin ≥ 0 at t0, < 0 at t1: bisect to round-off.
+            let (mut a, mut c) = (t0, t1);
+            for _ in 0..80 {
+                let m = 0.5 * (a + c);
+                if m <= a || m >= c {
+                    break;
+                }
+                if self.radau.interpolate(m, &mut y).is_err() {
+                    break;
+                }
+                if b.margin(&y) >= 0.0 {
+                    a = m;
+                } else {
+                    c = m;
+                }
+            }
+            if first.is_none_or(|(tf, _)| c < tf) {
+                first = Some((c, k));
+            }
+        }
+        first
+    }
+}
+
+impl Stepper for RadauStepper<'_> {
+    fn set_stop_time(&mut self, t_stop: f64) -> Result<(), String> {
+        self.t_stop = t_stop;
+        Ok(())
+    }
+    fn step(&mut self) -> Result<StepEnd, String> {
+        let report = self
+            .radau
+            .step(&mut self.sys, self.t_stop)
+            .map_err(|e| e.to_string())?;
+        if let Some((t, k)) = self.crossing() {
+            return Ok(StepEnd::Root(t, k));
+        }
+        Ok(if report.reached_stop {
+            StepEnd::StopReached
+        } else {
+            StepEnd::Internal
+        })
+    }
+    fn t_h(&self) -> (f64, f64) {
+        (self.radau.t(), self.radau.h())
+    }
+    fn y(&self) -> Vec<f64> {
+        self.radau.y().to_vec()
+    }
+    fn interpolate(&self, t: f64) -> Result<Vec<f64>, String> {
+        let mut y = vec![0.0; self.radau.y().len()];
+        self.radau
+            .interpolate(t, &mut y)
+            .map_err(|e| e.to_string())?;
+        Ok(y)
+    }
+    fn work(&self) -> Work {
+        let s = self.radau.stats();
+        Work {
+            steps: s.steps,
+            error_test_failures: s.rejected,
+            newton_iterations: s.newton_iterations,
+            newton_failures: s.newton_failures,
+            lu: s.lu_decompositions,
+        }
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn run_radau(
+    rec: &mut Recorder<'_>,
+    settings: &Settings,
+    t: f64,
+    t_stop: f64,
+    x: &[f64],
+    atol: &[f64],
+    nominal: &[f64],
+    limits: Vec<Bound>,
+    bad: &RefCell<Option<(f64, Vec<f64>)>>,
+    stats: &mut Statistics,
+) -> Result<Vec<f64>, SegmentError> {
+    let n = x.len();
+    let mut sys = RadauEquations {
+        eqs: rec.eqs,
+        nominal,
+        bad,
+        rhs_calls: 0,
+        jac_rhs_calls: 0,
+        xp: vec![0.0; n],
+        fxp: vec![0.0; n],
+    };
+    let options = RadauOptions {
+        rtol: settings.rtol,
+        atol: atol.to_vec(),
+        ..RadauOptions::default()
+    };
+    let radau = match Radau5::new(&mut sys, t, x, options) {
+        Ok(r) => r,
+        Err(e) => {
+            stats.rhs_evals += sys.rhs_calls;
+            let culprit = culprit(rec.eqs, bad);
+            return Err((
+                t,
+                x.to_vec(),
+                SimulationError::Solver {
+                    t,
+                    message: e.to_string(),
+                    culprit,
+                },
+            ));
+        }
+    };
+    let mut stepper = RadauStepper {
+        radau,
+        sys,
+        t_stop,
+        limits,
+    };
+    let limits = stepper.limits.clone();
+    let result = drive(
+        &mut stepper,
+        rec,
+        t_stop,
+        settings.max_steps,
+        &limits,
+        bad,
+        stats,
+    );
+    stats.rhs_evals += stepper.sys.rhs_calls;
+    stats.jac_rhs_evals += stepper.sys.jac_rhs_calls;
+    stats.jac_evals += stepper.radau.stats().jacobians;
+    result
 }

@@ -193,7 +193,10 @@ mod tests {
             for k in 1..=3 {
                 let lhs: f64 = (0..3).map(|j| a[i][j] * tab.c[j].powi(k - 1)).sum();
                 let want = tab.c[i].powi(k) / f64::from(k);
-                assert!((lhs - want).abs() < 1e-15, "row {i}, k {k}: {lhs} vs {want}");
+                assert!(
+                    (lhs - want).abs() < 1e-15,
+                    "row {i}, k {k}: {lhs} vs {want}"
+                );
             }
         }
     }
@@ -226,9 +229,17 @@ mod tests {
     fn error_coefficients_match_radau5() {
         let tab = Tableau::new();
         let s6 = 6f64.sqrt();
-        let want = [-(13.0 + 7.0 * s6) / 3.0, (-13.0 + 7.0 * s6) / 3.0, -1.0 / 3.0];
+        let want = [
+            -(13.0 + 7.0 * s6) / 3.0,
+            (-13.0 + 7.0 * s6) / 3.0,
+            -1.0 / 3.0,
+        ];
         for k in 0..3 {
-            assert!((tab.d[k] - want[k]).abs() < 1e-12, "{:?} vs {want:?}", tab.d);
+            assert!(
+                (tab.d[k] - want[k]).abs() < 1e-12,
+                "{:?} vs {want:?}",
+                tab.d
+            );
         }
     }
 }
