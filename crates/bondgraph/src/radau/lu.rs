@@ -154,7 +154,8 @@ mod tests {
         let mut jac = vec![0.0; n * n];
         for j in 0..n {
             for i in 0..n {
-                jac[j * n + i] = ((i * 7 + j * 3) % 5) as f64 - 2.0 + if i == j { 1.0 } else { 0.0 };
+                jac[j * n + i] =
+                    ((i * 7 + j * 3) % 5) as f64 - 2.0 + if i == j { 1.0 } else { 0.0 };
             }
         }
         jac[0] = 2.0;

@@ -327,9 +327,12 @@ impl Radau5 {
             len => return bad("atol", format!("needs 1 or {n} values, got {len}")),
         };
         if let Some(a) = atol.iter().find(|a| !(a.is_finite() && **a > 0.0)) {
-            return bad("atol", format!("each value must be finite and > 0, got {a}"));
+            return bad(
+                "atol",
+                format!("each value must be finite and > 0, got {a}"),
+            );
         }
-        if !(o.h_max > 0.0) {
+        if o.h_max.is_nan() || o.h_max <= 0.0 {
             return bad("h_max", format!("must be > 0, got {}", o.h_max));
         }
         if let Some(h0) = o.h0 {
@@ -512,7 +515,7 @@ impl Radau5 {
                 got: sys.n(),
             });
         }
-        if !(t_stop > self.t) || !t_stop.is_finite() {
+        if !t_stop.is_finite() || t_stop <= self.t {
             return Err(RadauError::StopNotAhead { t: self.t, t_stop });
         }
         self.eval_f0(sys)?;
@@ -630,8 +633,7 @@ impl Radau5 {
     /// Form and factorise (γ/h)I − J and ((α + iβ)/h)I − J.
     fn factorise(&mut self, h: f64) -> Result<(), lu::Singular> {
         let jac = self.jac.as_slice();
-        self.lu_real
-            .set_shifted(self.tab.gamma / h, jac, |v| v);
+        self.lu_real.set_shifted(self.tab.gamma / h, jac, |v| v);
         self.lu_real.factor()?;
         let shift = Complex::new(self.tab.alpha / h, self.tab.beta / h);
         self.lu_complex
@@ -657,7 +659,8 @@ impl Radau5 {
                     self.z[k][i] = zi[k];
                 }
                 for k in 0..3 {
-                    self.w[k][i] = tab.ti[k][0] * zi[0] + tab.ti[k][1] * zi[1] + tab.ti[k][2] * zi[2];
+                    self.w[k][i] =
+                        tab.ti[k][0] * zi[0] + tab.ti[k][1] * zi[1] + tab.ti[k][2] * zi[2];
                 }
             }
         } else {
@@ -713,7 +716,11 @@ impl Radau5 {
             }
             if newt > 1 && newt < nit {
                 let thq = dyno / dyno_old;
-                self.theta = if newt == 2 { thq } else { (thq * thq_old).sqrt() };
+                self.theta = if newt == 2 {
+                    thq
+                } else {
+                    (thq * thq_old).sqrt()
+                };
                 thq_old = thq;
                 if self.theta < 0.99 {
                     self.faccon = self.theta / (1.0 - self.theta);
@@ -790,7 +797,7 @@ impl Radau5 {
             let d12 = (z1 - z2) / c1mc2;
             let d23 = z1 / c[0];
             let d012 = (d12 - d01) / c1m1;
-            let d123 = (d23 - d12) / c[1];
+            let d123 = (d12 - d23) / c[1];
             self.cont[0][i] = d01;
             self.cont[1][i] = d012;
             self.cont[2][i] = d012 - d123;
