@@ -332,7 +332,7 @@ impl Radau5 {
                 format!("each value must be finite and > 0, got {a}"),
             );
         }
-        if !(o.h_max > 0.0) {
+        if o.h_max.is_nan() || o.h_max <= 0.0 {
             return bad("h_max", format!("must be > 0, got {}", o.h_max));
         }
         if let Some(h0) = o.h0 {
@@ -515,7 +515,7 @@ impl Radau5 {
                 got: sys.n(),
             });
         }
-        if !(t_stop > self.t) || !t_stop.is_finite() {
+        if !t_stop.is_finite() || t_stop <= self.t {
             return Err(RadauError::StopNotAhead { t: self.t, t_stop });
         }
         self.eval_f0(sys)?;
@@ -797,7 +797,7 @@ impl Radau5 {
             let d12 = (z1 - z2) / c1mc2;
             let d23 = z1 / c[0];
             let d012 = (d12 - d01) / c1m1;
-            let d123 = (d23 - d12) / c[1];
+            let d123 = (d12 - d23) / c[1];
             self.cont[0][i] = d01;
             self.cont[1][i] = d012;
             self.cont[2][i] = d012 - d123;

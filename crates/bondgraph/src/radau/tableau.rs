@@ -189,9 +189,9 @@ mod tests {
     fn a_satisfies_the_collocation_conditions() {
         let tab = Tableau::new();
         let a = radau_a();
-        for i in 0..3 {
+        for (i, row) in a.iter().enumerate() {
             for k in 1..=3 {
-                let lhs: f64 = (0..3).map(|j| a[i][j] * tab.c[j].powi(k - 1)).sum();
+                let lhs: f64 = (0..3).map(|j| row[j] * tab.c[j].powi(k - 1)).sum();
                 let want = tab.c[i].powi(k) / f64::from(k);
                 assert!(
                     (lhs - want).abs() < 1e-15,
@@ -208,7 +208,7 @@ mod tests {
         let tab = Tableau::new();
         assert!((tab.gamma - 3.637_834_252_744_496).abs() < 1e-13);
         assert!((tab.alpha - 2.681_082_873_627_752).abs() < 1e-13);
-        assert!((tab.beta - 3.050_430_199_247_410).abs() < 1e-13);
+        assert!((tab.beta - 3.050_430_199_247_41).abs() < 1e-13);
         let lam = mul(&mul(&tab.ti, &inv3(&radau_a())), &tab.t);
         let want = [
             [tab.gamma, 0.0, 0.0],
