@@ -8,7 +8,6 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use bondgraph::radau::*;
-use nalgebra::DMatrix;
 
 /// An ODE from two closures: f(t, y, dy) and J(t, y, jac).
 struct Sys<F, J> {

@@ -102,7 +102,10 @@ mod lu;
 mod stages;
 mod tableau;
 
-use nalgebra::{Complex, DMatrix};
+use nalgebra::Complex;
+/// The Jacobian's matrix type, re-exported so that implementing [`OdeSystem`] needs no
+/// direct dependency on nalgebra.
+pub use nalgebra::DMatrix;
 
 use controller::Controller;
 pub use error::RadauError;
