@@ -140,7 +140,9 @@ pub struct RadauOptions {
     /// max(10ε/rtol, min(0.03, √rtol)).
     pub newton_tol: Option<f64>,
     /// Convergence rate θ above which the Jacobian is recomputed for the next step (RADAU5:
-    /// 0.001). Larger values (0.1) save Jacobians when they are expensive.
+    /// 0.001). Larger values (0.1) save Jacobians when they are expensive: on the knuckle-boom
+    /// crane (38 states, finite-difference Jacobians) 0.1 needed 3–7× fewer Jacobians and
+    /// ran 1.3–1.7× faster than 0.001 at rtol 1e-3 to 1e-6.
     pub jacobian_theta: f64,
 }
 
