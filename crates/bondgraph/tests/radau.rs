@@ -8,7 +8,6 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use bondgraph::radau::*;
-use nalgebra::DMatrix;
 
 /// An ODE from two closures: f(t, y, dy) and J(t, y, jac).
 struct Sys<F, J> {
@@ -594,4 +593,44 @@ fn bad_inputs_are_refused() {
         ),
         "{e}"
     );
+}
+
+/// A Jacobian full of NaN makes every iteration matrix singular: the run ends with
+/// `SingularMatrix` at the start time instead of stepping with garbage.
+#[test]
+fn nan_jacobian_ends_with_singular_matrix() {
+    let mut s = sys(
+        1,
+        |_t, y: &[f64], dy: &mut [f64]| dy[0] = -y[0],
+        |_t, _y: &[f64], j: &mut DMatrix<f64>| j[(0, 0)] = f64::NAN,
+    );
+    let mut r = Radau5::new(&mut s, 0.0, &[1.0], opts(1e-6, 1e-6)).unwrap();
+    let e = r.step(&mut s, 1.0).unwrap_err();
+    assert!(
+        matches!(e, RadauError::SingularMatrix { t, .. } if t == 0.0),
+        "{e}"
+    );
+    assert_eq!(r.stats().singular, 5);
+}
+
+/// y' = −√y, y(0) = 1 reaches 0 at t = 2 (y = (1 − t/2)²), and f is NaN for y < 0: Newton
+/// iterations that stray below 0 are retried smaller, and the run ends near t = 2 with an
+/// error naming f(t, y) (the last accepted state is −2e-14, inside atol = 1e-10, where f is
+/// undefined), never with a NaN state.
+#[test]
+fn rhs_undefined_beyond_a_point_ends_with_an_error_there() {
+    let mut s = sys(
+        1,
+        |_t, y: &[f64], dy: &mut [f64]| dy[0] = -y[0].sqrt(),
+        |_t, y: &[f64], j: &mut DMatrix<f64>| j[(0, 0)] = -0.5 / y[0].sqrt(),
+    );
+    let mut r = Radau5::new(&mut s, 0.0, &[1.0], opts(1e-6, 1e-10)).unwrap();
+    let e = run(&mut s, &mut r, 3.0, |r, _| assert!(r.y()[0].is_finite())).unwrap_err();
+    println!("sqrt: {e} ({:?})", r.stats());
+    let t = match e {
+        RadauError::NonFinite { t, .. } | RadauError::NewtonDiverged { t, .. } => t,
+        other => panic!("unexpected error {other:?}"),
+    };
+    assert!((t - 2.0).abs() < 1e-3, "stopped at t = {t}");
+    assert!(r.stats().newton_failures > 0, "{:?}", r.stats());
 }

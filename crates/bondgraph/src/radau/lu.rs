@@ -4,6 +4,10 @@
 //! nalgebra's `LU::new` takes the matrix by value and allocates its permutation on every
 //! call; the integrator factorises two matrices per step-size change, so it keeps its own
 //! buffers and factorises here without touching the heap.
+//!
+//! The complex system ((α + iβ)/h)I − J could also be solved as a real 2n×2n system; measured
+//! with this code (factorisation and one solve), the complex n×n form is 1.8× faster at
+//! n = 10, 2.0× at n = 38 and 1.3× at n = 100.
 
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
