@@ -430,7 +430,8 @@ fn invalid_settings_are_refused() {
 }
 
 /// The statistics add up: the Jacobian work of the implicit methods is counted, Tsit45 needs
-/// none, and every accepted step cost at least one right-hand-side evaluation.
+/// none, and every accepted step cost at least one right-hand-side evaluation. (Radau5 takes
+/// the exact Jacobian of the evaluation plan, which costs no right-hand side.)
 #[test]
 fn statistics_are_consistent() {
     for method in Method::ALL {
@@ -455,10 +456,13 @@ fn statistics_are_consistent() {
             assert_eq!(s.jac_rhs_evals, 0, "{s}");
         } else {
             assert!(
-                s.jac_evals >= 1 && s.jac_rhs_evals >= 1 && s.lu_factorisations >= 1,
+                s.jac_evals >= 1 && s.lu_factorisations >= 1,
                 "{}: {s}",
                 method.name()
             );
+            if method == Method::Radau5 {
+                assert_eq!(s.jac_rhs_evals, 0, "{s}");
+            }
         }
     }
 }
