@@ -1077,10 +1077,7 @@ fn run_radau(
     let options = RadauOptions {
         rtol: settings.rtol,
         atol: atol.to_vec(),
-        jacobian_theta: std::env::var("JT")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(0.001),
+        jacobian_theta: RADAU_JACOBIAN_THETA,
         ..RadauOptions::default()
     };
     let radau = match Radau5::new(&mut sys, t, x, options) {
