@@ -356,17 +356,20 @@ pub fn table(rows: &[BenchRow]) -> String {
     s
 }
 
-/// The cost of one right-hand side (and of one Jacobian, where the equations give one).
+/// The cost of one right-hand side and of one Jacobian.
 #[derive(Clone, Debug)]
 pub struct RhsCost {
     /// Number of states.
     pub n: usize,
     /// Median µs per rhs evaluation.
     pub rhs_us: f64,
+    /// Median µs per exact Jacobian ([`StateEquations::jacobian`](bondgraph::StateEquations::jacobian)).
+    pub jacobian_us: f64,
 }
 
-/// Time the model's right-hand side at its initial state, `calls` calls per sample, median
-/// of 7 samples.
+/// Time the model's right-hand side and Jacobian near its initial state (the state nudged
+/// every call, so that no element's cache answers), `calls` rhs calls per sample, median of
+/// 7 samples.
 #[must_use]
 pub fn rhs_cost(model: &Model, calls: usize) -> RhsCost {
     let eqs = &model.equations;
@@ -388,9 +391,25 @@ pub fn rhs_cost(model: &Model, calls: usize) -> RhsCost {
         samples.push(start.elapsed().as_secs_f64() * 1e6 / calls as f64);
     }
     samples.sort_by(f64::total_cmp);
+    let rhs_us = samples[samples.len() / 2];
+    let mut jac = bondgraph::DMatrix::zeros(n, n);
+    eqs.jacobian(t, &x0, &mut jac);
+    let jac_calls = (calls / 20).max(1);
+    let mut samples = Vec::new();
+    for _ in 0..7 {
+        let mut x = x0.clone();
+        let start = Instant::now();
+        for k in 0..jac_calls {
+            x[k % n.max(1)] += 1e-12 * (1.0 + x[k % n.max(1)].abs());
+            eqs.jacobian(t, &x, &mut jac);
+        }
+        samples.push(start.elapsed().as_secs_f64() * 1e6 / jac_calls as f64);
+    }
+    samples.sort_by(f64::total_cmp);
     RhsCost {
         n,
-        rhs_us: samples[samples.len() / 2],
+        rhs_us,
+        jacobian_us: samples[samples.len() / 2],
     }
 }
 

@@ -238,10 +238,12 @@ fn bench(a: &BenchArgs<'_>) -> ExitCode {
     if a.rhs_only {
         let c = rhs_cost(&model, 20_000);
         println!(
-            "{}: {} states; rhs {:.3} µs per call (median of 7 × 20 000 calls)",
+            "{}: {} states; rhs {:.3} µs per call, Jacobian {:.3} µs per call ({:.1} rhs-equivalents; medians of 7 samples)",
             model.file(),
             c.n,
-            c.rhs_us
+            c.rhs_us,
+            c.jacobian_us,
+            c.jacobian_us / c.rhs_us
         );
         return ExitCode::SUCCESS;
     }
