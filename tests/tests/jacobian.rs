@@ -110,11 +110,15 @@ fn perturbed(eqs: &StateEquations, x0: &[f64], k: usize) -> Vec<f64> {
 
 fn check_model(path: &std::path::Path) -> Option<f64> {
     let model = bg_model::Model::load(path, &bg_sim::registry(), &[]).ok()?;
-    let eqs = &model.equations;
+    let name = path.file_stem()?.to_string_lossy().into_owned();
+    check_equations(&name, &model.equations)
+}
+
+fn check_equations(name: &str, eqs: &StateEquations) -> Option<f64> {
     if eqs.n_states() == 0 {
         return None;
     }
-    let name = path.file_stem()?.to_string_lossy().into_owned();
+    let name = name.to_owned();
     let x0 = eqs.initial_state();
     let mut worst = compare(&name, eqs, 0.0, &x0);
     for k in 1..=3 {
@@ -125,7 +129,7 @@ fn check_model(path: &std::path::Path) -> Option<f64> {
         }
     }
     eprintln!(
-        "{name}: worst entry J[{}][{}] ({} / {}) at {:.3} of the allowance",
+        "{name}: worst entry J[{}][{}] ({} / {}) at {:.1e} of the allowance",
         worst.1,
         worst.2,
         eqs.states()[worst.1].name,
@@ -147,6 +151,12 @@ fn jacobian_matches_central_differences_for_every_model() {
 }
 
 #[test]
+fn jacobian_matches_central_differences_for_every_element_kind() {
+    let model = bg_tests::every_kind().unwrap();
+    assert!(check_equations("every_kind", &model.equations).is_some());
+}
+
+#[test]
 fn crane_jacobian_matches_central_differences_after_a_short_run() {
     let mut model = bg_tests::load("knuckle_boom", &["simulation.t_end=0.05"]).unwrap();
     let out = model.run().unwrap();
@@ -154,7 +164,7 @@ fn crane_jacobian_matches_central_differences_after_a_short_run() {
     let t = out.t_final;
     let w = compare("knuckle_boom", &model.equations, t, &out.x_final);
     eprintln!(
-        "knuckle_boom after {t} s: worst at {:.3} of the allowance",
+        "knuckle_boom after {t} s: worst at {:.1e} of the allowance",
         w.0
     );
 }

@@ -530,12 +530,13 @@ impl Param {
     }
 
     /// Partial derivatives of the value with respect to its inputs (the element's inputs
-    /// `first..first + n_inputs`), into `grad[..n_inputs]`; nothing for a constant.
+    /// `first..first + n_inputs`): calls `f(k, ∂value/∂u_k)` for each input k; nothing for
+    /// a constant.
     ///
     /// A law is a closure, so the derivatives are central differences of the law alone
     /// (step ∛ε·max(|u|, 1e-3); error about 1e-10 relative for smooth laws): cheap, and
     /// free of allocation for up to [`MAX_PARAM_INPUTS`] inputs.
-    pub fn gradient(&self, io: &Io<'_>, first: usize, grad: &mut [f64]) {
+    pub fn partials(&self, io: &Io<'_>, first: usize, mut f: impl FnMut(usize, f64)) {
         let Self::Modulated { inputs, law } = self else {
             return;
         };
@@ -552,7 +553,7 @@ impl Param {
             *b = io.u(first + k);
         }
         let t = io.time();
-        for (k, g) in grad.iter_mut().take(n).enumerate() {
+        for k in 0..n {
             let v = u[k];
             let h = central_step(v, 1e-3);
             u[k] = v + h;
@@ -560,7 +561,7 @@ impl Param {
             u[k] = v - h;
             let minus = law(t, u);
             u[k] = v;
-            *g = (plus - minus) / (2.0 * h);
+            f(k, (plus - minus) / (2.0 * h));
         }
     }
 }

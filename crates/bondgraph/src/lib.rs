@@ -69,7 +69,7 @@ pub use elements::*;
 pub use equations::{Probe, StateEquations, StateInfo};
 pub use error::{CausalityError, Error, GraphError, ParamError, SimulationError};
 pub use graph::{BondGraph, Node};
-pub use local_jacobian::{LocalJacobian, LocalShape};
+pub use local_jacobian::{check_partials, LocalJacobian, LocalShape};
 /// The dense matrix type of [`StateEquations::jacobian`].
 pub use nalgebra::DMatrix;
 pub use radau::{OdeSystem, Radau5, RadauError, RadauOptions, RadauStats, StepReport};
