@@ -7,10 +7,10 @@
 
 use nalgebra::{DVector, Vector3};
 
-use crate::kinematics::ArmKinematics;
+use super::StationKinematics;
 use crate::screw::{swap, wrench};
 
-impl ArmKinematics<'_> {
+impl StationKinematics<'_> {
     /// G(q) of eq. 45.
     #[must_use]
     pub fn gravity_forces(&self) -> DVector<f64> {

@@ -29,23 +29,23 @@
 
 use nalgebra::{DMatrix, DVector, Vector2};
 
+use super::{MassPoint, StationKinematics};
 use crate::arm::z_cross;
-use crate::kinematics::{ArmKinematics, MassPoint};
 
 /// Velocity terms of one mass point at speeds u (frame of its link).
-pub(crate) struct PointVelocity {
+pub(super) struct PointVelocity {
     /// Linear velocity v.
-    pub(crate) v: Vector2<f64>,
+    pub(super) v: Vector2<f64>,
     /// φ̇_i of the point's link.
-    pub(crate) phi_dot: f64,
+    pub(super) phi_dot: f64,
     /// `a_v = Ṗ u` (linear part; the angular part is zero).
-    pub(crate) a_v: Vector2<f64>,
+    pub(super) a_v: Vector2<f64>,
 }
 
 impl MassPoint<'_> {
     /// Velocity terms at speeds u; `on_partial(k, ∂v/∂q_k, v)` is called for every coordinate
     /// k the velocity depends on (joints 1..=i of the chain, then the link's modes).
-    pub(crate) fn velocity_with(
+    pub(super) fn velocity_with(
         &self,
         u: &[f64],
         modal_offset: usize,
@@ -73,12 +73,12 @@ impl MassPoint<'_> {
         PointVelocity { v, phi_dot, a_v }
     }
 
-    pub(crate) fn velocity(&self, u: &[f64], modal_offset: usize) -> PointVelocity {
+    pub(super) fn velocity(&self, u: &[f64], modal_offset: usize) -> PointVelocity {
         self.velocity_with(u, modal_offset, |_, _, _| ())
     }
 }
 
-impl ArmKinematics<'_> {
+impl StationKinematics<'_> {
     /// E = ∂T/∂q at constant u (eq. 44).
     #[must_use]
     pub fn kinetic_forces(&self, u: &[f64]) -> DVector<f64> {
@@ -130,7 +130,7 @@ impl ArmKinematics<'_> {
 }
 
 /// Solve `M x = b` for symmetric positive definite M (Cholesky, LU as a fallback).
-pub(crate) fn solve(m: DMatrix<f64>, b: &DVector<f64>) -> Option<DVector<f64>> {
+fn solve(m: DMatrix<f64>, b: &DVector<f64>) -> Option<DVector<f64>> {
     match m.clone().cholesky() {
         Some(c) => Some(c.solve(b)),
         None => m.lu().solve(b),

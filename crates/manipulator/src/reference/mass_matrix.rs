@@ -9,11 +9,11 @@
 
 use nalgebra::DMatrix;
 
-use crate::kinematics::{ArmKinematics, MassPoint};
+use super::{MassPoint, StationKinematics};
 use crate::screw::Screw;
 
 /// `D t` for the inertia of a mass point (eq. 40).
-pub(crate) fn inertia_times(p: &MassPoint<'_>, t: &Screw) -> Screw {
+pub(super) fn inertia_times(p: &MassPoint<'_>, t: &Screw) -> Screw {
     Screw::new(
         p.inertia * t[0],
         p.inertia * t[1],
@@ -24,7 +24,7 @@ pub(crate) fn inertia_times(p: &MassPoint<'_>, t: &Screw) -> Screw {
     )
 }
 
-impl ArmKinematics<'_> {
+impl StationKinematics<'_> {
     /// M(q) of eq. 42 (n×n, symmetric positive definite for a well-posed arm).
     #[must_use]
     pub fn mass_matrix(&self) -> DMatrix<f64> {

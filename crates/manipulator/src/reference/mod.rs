@@ -1,69 +1,90 @@
-//! [`ArmKinematics`]: the projection matrix of every mass-carrying station at one
-//! configuration, computed once and shared by M (eq. 42), E (eq. 44), G (eq. 45) and the
-//! reaction forces.
+//! The per-station reference: M (eq. 42), T (eq. 41), E (eq. 44), Ṁu, G and V_g (eqs.
+//! 45–48), K (eq. 51) and the reactions (eq. 97) summed over the Gauss–Legendre points and
+//! point masses of every link with the projection matrix of each station (eq. 38), as the
+//! paper writes them.
 //!
-//! The I-, C-field and reaction block of one arm all evaluate at the same q in one
-//! right-hand-side evaluation, so the arm keeps the projections of the configuration it was
-//! last asked for and hands them out again for the same q (compared bit for bit).
+//! This is what the arm computed before its [`ShapeIntegrals`](crate::ShapeIntegrals): it
+//! allocates and costs O(points × modes) per link, so it is not for the right-hand side. The
+//! tests hold the Gram-matrix code ([`ArmKinematics`](crate::ArmKinematics)) to it.
 
-use std::sync::Arc;
+mod gravity;
+mod kinetic_forces;
+mod mass_matrix;
+mod reactions;
+
+use nalgebra::DMatrix;
 
 use crate::arm::{PlanarArm, Pose, Station};
 use crate::projection::Projection;
 
+/// A station carrying mass: a quadrature point of a link (mass `w·ρA`, rotary inertia `w·ρI`)
+/// or a point mass.
+#[derive(Clone, Debug)]
+struct MassStation {
+    station: Station,
+    mass: f64,
+    inertia: f64,
+}
+
 /// One mass-carrying station at a configuration: its projection and its inertia.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct MassPoint<'a> {
-    pub(crate) projection: &'a Projection,
+struct MassPoint<'a> {
+    projection: &'a Projection,
     /// Mass (kg): `w·ρA` for a quadrature point, `m` for a point mass.
-    pub(crate) mass: f64,
+    mass: f64,
     /// Rotary inertia about z (kg·m²): `w·ρI`, or a point mass's own.
-    pub(crate) inertia: f64,
+    inertia: f64,
     /// The station (link, x, mode values).
-    pub(crate) station: &'a Station,
+    station: &'a Station,
 }
 
-/// The projections of the last configuration an arm was asked for.
-pub(crate) type ProjectionCache = Option<(Vec<f64>, Arc<Vec<Projection>>)>;
-
-/// The arm at configuration q with the projection matrix of each of its mass stations.
+/// The arm at configuration q with the projection matrix of each of its mass stations
+/// (the arm's [`quadrature`](PlanarArm::quadrature) along every link).
 #[derive(Clone, Debug)]
-pub struct ArmKinematics<'a> {
-    pub(crate) pose: Pose<'a>,
-    projections: Arc<Vec<Projection>>,
+pub struct StationKinematics<'a> {
+    pose: Pose<'a>,
+    stations: Vec<MassStation>,
+    projections: Vec<Projection>,
 }
 
-impl PlanarArm {
-    /// Kinematics at `q` (projections of every quadrature point and point mass).
+impl<'a> StationKinematics<'a> {
+    /// Kinematics of `arm` at `q`.
     ///
     /// # Panics
-    /// If `q.len() != self.n()`.
+    /// If `q.len() != arm.n()`.
     #[must_use]
-    pub fn kinematics<'a>(&'a self, q: &'a [f64]) -> ArmKinematics<'a> {
-        let pose = self.pose(q);
-        // A poisoned cache only means another thread panicked while filling it: refill it.
-        let mut cache = self
-            .projection_cache()
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner);
-        let projections = match cache.as_ref() {
-            Some((key, p)) if key.as_slice() == q => p.clone(),
-            _ => {
-                let p: Arc<Vec<Projection>> = Arc::new(
-                    self.mass_stations()
-                        .iter()
-                        .map(|ms| Projection::at(&pose, &ms.station))
-                        .collect(),
-                );
-                *cache = Some((q.to_vec(), p.clone()));
-                p
+    pub fn new(arm: &'a PlanarArm, q: &'a [f64]) -> Self {
+        let pose = arm.pose(q);
+        let mut stations = Vec::new();
+        for (i, link) in arm.links().iter().enumerate() {
+            if link.has_distributed_mass() {
+                for (x, w) in arm.quadrature().on(link.length()) {
+                    stations.push(MassStation {
+                        station: arm.station_unchecked(i, x),
+                        mass: w * link.mass_per_length(),
+                        inertia: w * link.rotary_inertia_per_length(),
+                    });
+                }
             }
-        };
-        ArmKinematics { pose, projections }
+            for m in link.point_masses() {
+                stations.push(MassStation {
+                    station: arm.station_unchecked(i, m.x),
+                    mass: m.mass,
+                    inertia: m.inertia,
+                });
+            }
+        }
+        let projections = stations
+            .iter()
+            .map(|ms| Projection::at(&pose, &ms.station))
+            .collect();
+        Self {
+            pose,
+            stations,
+            projections,
+        }
     }
-}
 
-impl<'a> ArmKinematics<'a> {
     /// The configuration.
     #[must_use]
     pub fn pose(&self) -> &Pose<'a> {
@@ -75,9 +96,8 @@ impl<'a> ArmKinematics<'a> {
         self.pose.arm()
     }
     /// Every mass-carrying station with its projection.
-    pub(crate) fn points(&self) -> impl Iterator<Item = MassPoint<'_>> {
-        self.arm()
-            .mass_stations()
+    fn points(&self) -> impl Iterator<Item = MassPoint<'_>> {
+        self.stations
             .iter()
             .zip(self.projections.iter())
             .map(|(ms, projection)| MassPoint {
@@ -87,4 +107,24 @@ impl<'a> ArmKinematics<'a> {
                 station: &ms.station,
             })
     }
+}
+
+/// K of eq. 51 (n×n) by the arm's quadrature: `Σ_i E_iI_i Σ_points w ψ''ψ''ᵀ`.
+#[must_use]
+pub fn stiffness_matrix(arm: &PlanarArm) -> DMatrix<f64> {
+    let n = arm.n();
+    let mut k = DMatrix::zeros(n, n);
+    for (i, link) in arm.links().iter().enumerate() {
+        let o = arm.modal_offset(i);
+        let modes = link.modes();
+        for (x, w) in arm.quadrature().on(link.length()) {
+            let c: Vec<f64> = modes.iter().map(|m| m.curvature(x)).collect();
+            for a in 0..modes.len() {
+                for b in 0..modes.len() {
+                    k[(o + a, o + b)] += link.bending_stiffness() * w * c[a] * c[b];
+                }
+            }
+        }
+    }
+    k
 }

@@ -28,23 +28,15 @@
 
 use nalgebra::{DVector, Vector2, Vector3};
 
+use super::{MassPoint, StationKinematics};
 use crate::arm::{z_cross, Station};
-use crate::kinematics::{ArmKinematics, MassPoint};
 use crate::projection::Projection;
+use crate::reactions::PointLoad;
 use crate::screw::{line_x, line_y, rot_z_cs, swap, wrench, Screw, ScrewTransform};
-
-/// A force (frame 0, N) applied at a station of the arm.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PointLoad {
-    /// Where it acts.
-    pub station: Station,
-    /// The force in frame 0.
-    pub force: Vector2<f64>,
-}
 
 impl MassPoint<'_> {
     /// Inertial acceleration `[0 0 α a_x a_y 0]` of the point, in its link's frame.
-    pub(crate) fn acceleration(&self, u: &[f64], u_dot: &[f64], modal_offset: usize) -> Screw {
+    pub(super) fn acceleration(&self, u: &[f64], u_dot: &[f64], modal_offset: usize) -> Screw {
         let pv = self.velocity(u, modal_offset);
         let pa = self.projection.twist(u_dot);
         let a = Vector2::new(pa[3], pa[4]) + pv.a_v + pv.phi_dot * z_cross(&pv.v);
@@ -52,7 +44,7 @@ impl MassPoint<'_> {
     }
 }
 
-impl ArmKinematics<'_> {
+impl StationKinematics<'_> {
     /// The auxiliary projection columns `V_{i_e,j}^{i,j} Π [L_x L_y]` (eq. 88) of joint j for
     /// a point of link i at `r` (frame 0).
     fn auxiliary_columns(&self, i: usize, j: usize, r: &Vector2<f64>) -> [Screw; 2] {
@@ -106,7 +98,7 @@ impl ArmKinematics<'_> {
             let i = p.projection.link();
             let r = self.pose.position(p.station);
             let a = p.acceleration(u, u_dot, arm.modal_offset(i));
-            let d_a = crate::mass_matrix::inertia_times(&p, &a);
+            let d_a = super::mass_matrix::inertia_times(&p, &a);
             let gw = self.pose.screw_to_frame(i).apply(&wrench(
                 Vector3::new(0.0, -p.mass * g, 0.0),
                 Vector3::zeros(),
