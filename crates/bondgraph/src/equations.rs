@@ -67,7 +67,8 @@ pub struct StateEquations {
     effort_setter: Vec<ElementId>,
     layouts: Vec<Layout>,
     order: Vec<(ElementId, usize)>,
-    /// `order` without the stages whose results only outputs read (skipped by `rhs`).
+    /// `order` without the stages whose results only outputs read, directly or through other
+    /// such stages (skipped by `rhs`).
     rhs_order: Vec<(ElementId, usize)>,
     /// Per element, per stage: the variables it writes (for diagnostics).
     writes: Vec<Vec<Vec<Var>>>,
@@ -405,39 +406,65 @@ impl StateEquations {
         match toposort(&dep, None) {
             Ok(order) => {
                 self.order = order.into_iter().map(|ix| dep[ix]).collect();
-                // A stage that writes only signals no element reads (reaction forces, energy
-                // reports) matters for output rows, not for dx/dt: `rhs` skips it.
-                let read: std::collections::HashSet<usize> = self
-                    .layouts
-                    .iter()
-                    .flat_map(|l| l.inputs.iter())
-                    .filter_map(|&(src, dim)| match src {
-                        Source::Signal(o) => Some(o..o + dim),
-                        _ => None,
-                    })
-                    .flatten()
-                    .collect();
-                let output_only = |id: ElementId, s: usize| {
-                    let w = &self.writes[id][s];
-                    !w.is_empty()
-                        && w.iter().all(|v| match *v {
-                            Var::Signal(e, i) => {
-                                let (o, d) = self.layouts[e].outputs[i];
-                                !(o..o + d).any(|k| read.contains(&k))
-                            }
-                            _ => false,
-                        })
-                };
-                self.rhs_order = self
-                    .order
-                    .iter()
-                    .copied()
-                    .filter(|&(id, s)| !output_only(id, s))
-                    .collect();
+                self.rhs_order = self.rhs_stages();
                 Ok(())
             }
             Err(_) => Err(self.loop_error(&dep, &reads, &writer).into()),
         }
+    }
+
+    /// `order` without the stages whose results dx/dt does not need: a stage that writes only
+    /// signals (reaction forces, energy reports) is skipped by `rhs` unless an element that
+    /// takes part in dx/dt reads one of them — an element with states (its derivatives may
+    /// read any input) or one with a stage that is not skipped. Found as a fixed point, so a
+    /// signal read only by skipped stages (the accelerations the reaction forces read) is
+    /// skipped too.
+    fn rhs_stages(&self) -> Vec<(ElementId, usize)> {
+        let signals_only = |id: ElementId, s: usize| {
+            let w = &self.writes[id][s];
+            !w.is_empty() && w.iter().all(|v| matches!(v, Var::Signal(..)))
+        };
+        let mut skipped: std::collections::HashSet<(ElementId, usize)> = self
+            .order
+            .iter()
+            .copied()
+            .filter(|&(id, s)| signals_only(id, s))
+            .collect();
+        loop {
+            let needed: std::collections::HashSet<usize> = self
+                .layouts
+                .iter()
+                .enumerate()
+                .filter(|&(id, l)| {
+                    l.n_states > 0
+                        || (0..self.writes[id].len()).any(|s| !skipped.contains(&(id, s)))
+                })
+                .flat_map(|(_, l)| l.inputs.iter())
+                .filter_map(|&(src, dim)| match src {
+                    Source::Signal(o) => Some(o..o + dim),
+                    _ => None,
+                })
+                .flatten()
+                .collect();
+            let before = skipped.len();
+            skipped.retain(|&(id, s)| {
+                self.writes[id][s].iter().all(|v| match *v {
+                    Var::Signal(e, i) => {
+                        let (o, d) = self.layouts[e].outputs[i];
+                        !(o..o + d).any(|k| needed.contains(&k))
+                    }
+                    _ => false,
+                })
+            });
+            if skipped.len() == before {
+                break;
+            }
+        }
+        self.order
+            .iter()
+            .copied()
+            .filter(|st| !skipped.contains(st))
+            .collect()
     }
 
     fn loop_error(

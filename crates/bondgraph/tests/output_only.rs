@@ -1,4 +1,5 @@
-//! Stages whose signals only outputs read are skipped by `rhs` and run for output rows.
+//! Stages whose signals only outputs read — directly or through other such stages — are
+//! skipped by `rhs` and run for output rows.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::cell::Cell;
@@ -7,7 +8,7 @@ use std::rc::Rc;
 use bondgraph::*;
 
 #[derive(Debug)]
-struct Counter(Rc<Cell<usize>>);
+struct Counter(Rc<Cell<usize>>, &'static str);
 
 impl Element for Counter {
     fn kind(&self) -> &str {
@@ -20,7 +21,7 @@ impl Element for Counter {
         CausalRule::None
     }
     fn signal_inputs(&self) -> Vec<SignalSpec> {
-        vec![SignalSpec::scalar("spring.q")]
+        vec![SignalSpec::scalar(self.1)]
     }
     fn signal_outputs(&self) -> Vec<SignalSpec> {
         vec![SignalSpec::scalar("twice")]
@@ -33,9 +34,19 @@ impl Element for Counter {
 }
 
 fn oscillator(counter: Rc<Cell<usize>>, read_by_source: bool) -> StateEquations {
+    oscillator_reading(counter, read_by_source.then_some("probe.twice"), None)
+}
+
+/// The oscillator with a probe of the spring, an optional second probe of the first, and a
+/// source that reads `source_reads`.
+fn oscillator_reading(
+    counter: Rc<Cell<usize>>,
+    source_reads: Option<&str>,
+    second: Option<Rc<Cell<usize>>>,
+) -> StateEquations {
     let mut g = BondGraph::new();
-    let force = if read_by_source {
-        Param::modulated(vec!["probe.twice".into()], |_, u| -0.0 * u[0])
+    let force = if let Some(name) = source_reads {
+        Param::modulated(vec![name.into()], |_, u| -0.0 * u[0])
     } else {
         Param::Const(0.0)
     };
@@ -43,7 +54,10 @@ fn oscillator(counter: Rc<Cell<usize>>, read_by_source: bool) -> StateEquations 
     g.add("v", OneJunction).unwrap();
     g.add("mass", Inertia::new(1.0, 0.0).unwrap()).unwrap();
     g.add("spring", Capacitor::new(0.1, 0.01).unwrap()).unwrap();
-    g.add("probe", Counter(counter)).unwrap();
+    g.add("probe", Counter(counter, "spring.q")).unwrap();
+    if let Some(c) = second {
+        g.add("probe2", Counter(c, "probe.twice")).unwrap();
+    }
     for (a, b) in [("f", "v"), ("v", "mass"), ("v", "spring")] {
         g.connect_names(a, b).unwrap();
     }
@@ -72,4 +86,23 @@ fn a_signal_read_by_an_element_is_computed_by_rhs() {
     let mut dx = vec![0.0; 2];
     eqs.rhs(0.0, &x, &mut dx);
     assert_eq!(n.get(), 1);
+}
+
+#[test]
+fn a_signal_read_only_by_skipped_stages_is_skipped_too() {
+    let (n, n2) = (Rc::new(Cell::new(0)), Rc::new(Cell::new(0)));
+    let eqs = oscillator_reading(n.clone(), None, Some(n2.clone()));
+    let x = eqs.initial_state();
+    let mut dx = vec![0.0; 2];
+    eqs.rhs(0.0, &x, &mut dx);
+    assert_eq!((n.get(), n2.get()), (0, 0));
+    eqs.evaluate(0.0, &x);
+    assert_eq!((n.get(), n2.get()), (1, 1));
+    let p = eqs.probe("probe2.twice").unwrap();
+    assert!((eqs.read(p, 0.0, &x) - 0.04).abs() < 1e-15);
+    // once the source reads the second probe, both run in rhs
+    let (n, n2) = (Rc::new(Cell::new(0)), Rc::new(Cell::new(0)));
+    let eqs = oscillator_reading(n.clone(), Some("probe2.twice"), Some(n2.clone()));
+    eqs.rhs(0.0, &x, &mut dx);
+    assert_eq!((n.get(), n2.get()), (1, 1));
 }

@@ -9,13 +9,11 @@
 //! sine-rule expressions (eqs. 52–63) approximate the same exact distances to second order in
 //! the deflection; here the distances are exact (design page).
 
-use nalgebra::{DMatrix, DVector, Vector2, Vector3};
+use nalgebra::{DMatrix, DVector, Vector2};
 
 use crate::arm::{PlanarArm, Pose};
 use crate::error::ManipulatorError;
-use crate::pin::Pin;
-use crate::projection::Projection;
-use crate::screw::{swap, wrench};
+use crate::pin::{Pin, PinPoint};
 
 /// A linear actuator (hydraulic cylinder) between pins `a` and `b`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -67,20 +65,13 @@ impl PlanarArm {
         Ok(())
     }
 
-    /// The generalized force `Pᵀ Π w` of a point force `f` (frame 0) at `pin` (eq. 49); zero
-    /// for a ground pin.
+    /// The generalized force `Pᵀ Π w = (∂r/∂q)ᵀ f` of a point force `f` (frame 0) at `pin`
+    /// (eq. 49); zero for a ground pin.
     #[must_use]
     pub fn generalized_force(&self, pose: &Pose<'_>, pin: &Pin, f: &Vector2<f64>) -> DVector<f64> {
         let mut tau = DVector::zeros(self.n());
-        if let Pin::Link { link, x } = *pin {
-            let Ok(s) = self.station(link, x) else {
-                return tau;
-            };
-            let p = Projection::at(pose, &s);
-            let wi = pose
-                .screw_to_frame(link)
-                .apply(&wrench(Vector3::new(f.x, f.y, 0.0), Vector3::zeros()));
-            p.add_transpose_times(&swap(&wi), tau.as_mut_slice());
+        if let Ok(p) = self.resolve_pin(pin) {
+            pose.add_pin_force(&p, f, tau.as_mut_slice());
         }
         tau
     }
@@ -91,11 +82,25 @@ impl PlanarArm {
     pub fn actuator_jacobian(&self, pose: &Pose<'_>, acts: &[LinearActuator]) -> DMatrix<f64> {
         let mut t = DMatrix::zeros(self.n(), acts.len());
         for (c, act) in acts.iter().enumerate() {
-            let e = act.direction(pose);
-            let col =
-                self.generalized_force(pose, &act.b, &e) - self.generalized_force(pose, &act.a, &e);
-            t.column_mut(c).copy_from(&col);
+            if let (Ok(a), Ok(b)) = (self.resolve_pin(&act.a), self.resolve_pin(&act.b)) {
+                let _ = pose.actuator_length(&a, &b, t.column_mut(c).as_mut_slice());
+            }
         }
         t
+    }
+}
+
+impl Pose<'_> {
+    /// The length `l = |b − a|` of an actuator between resolved pins, with its gradient
+    /// `∂l/∂q = (∂r_b/∂q − ∂r_a/∂q)ᵀ e` (e = (b − a)/l) written into `gradient` (length n):
+    /// a column of τ_b (eqs. 66–68), without allocating.
+    pub fn actuator_length(&self, a: &PinPoint, b: &PinPoint, gradient: &mut [f64]) -> f64 {
+        let d = self.pin_point_position(b) - self.pin_point_position(a);
+        let l = d.norm();
+        let e = d / l;
+        gradient.fill(0.0);
+        self.add_pin_force(b, &e, gradient);
+        self.add_pin_force(a, &-e, gradient);
+        l
     }
 }

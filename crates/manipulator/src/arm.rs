@@ -11,17 +11,17 @@
 //! frame 0 for i = 1, at the end of link i−1's chord otherwise; its x axis runs along link
 //! i's chord at the angle `φ_i = q_1 + … + q_i` from x₀.
 
-use std::sync::Mutex;
+use std::borrow::Cow;
 
 use nalgebra::Vector2;
 
 use crate::error::ManipulatorError;
 use crate::joint::RevoluteJoint;
-use crate::kinematics::ProjectionCache;
 use crate::link::Link;
 use crate::pin::Pin;
 use crate::quadrature::GaussLegendre;
 use crate::screw::{rot_z_cs, CoordinateTransform};
+use crate::shape_integrals::ShapeIntegrals;
 
 /// A point on a link's axis at distance `x` along its chord, with the mode shapes evaluated
 /// there (`ψ_k(x)`, `θ_k(x)`).
@@ -35,17 +35,8 @@ pub struct Station {
     pub(crate) theta: Vec<f64>,
 }
 
-/// A station carrying mass: a quadrature point of a link (mass `w·ρA`, rotary inertia `w·ρI`)
-/// or a point mass.
-#[derive(Clone, Debug)]
-pub(crate) struct MassStation {
-    pub(crate) station: Station,
-    pub(crate) mass: f64,
-    pub(crate) inertia: f64,
-}
-
 /// A planar serial manipulator.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct PlanarArm {
     links: Vec<Link>,
     joint: RevoluteJoint,
@@ -53,23 +44,7 @@ pub struct PlanarArm {
     quadrature: GaussLegendre,
     modal_offset: Vec<usize>,
     n: usize,
-    mass_stations: Vec<MassStation>,
-    cache: Mutex<ProjectionCache>,
-}
-
-impl Clone for PlanarArm {
-    fn clone(&self) -> Self {
-        Self {
-            links: self.links.clone(),
-            joint: self.joint,
-            gravity: self.gravity,
-            quadrature: self.quadrature.clone(),
-            modal_offset: self.modal_offset.clone(),
-            n: self.n,
-            mass_stations: self.mass_stations.clone(),
-            cache: Mutex::new(None),
-        }
-    }
+    integrals: Vec<ShapeIntegrals>,
 }
 
 impl PlanarArm {
@@ -79,7 +54,9 @@ impl PlanarArm {
         Self::with_quadrature(links, gravity, GaussLegendre::DEFAULT_POINTS)
     }
 
-    /// As [`new`](Self::new) with `points` Gauss–Legendre points per link.
+    /// As [`new`](Self::new) with `points` Gauss–Legendre points per link: the rule of the
+    /// per-station [`reference`](crate::reference), and at least the rule of the shape
+    /// integrals of links whose modes are not sines ([`ShapeIntegrals::of`]).
     pub fn with_quadrature(
         links: Vec<Link>,
         gravity: f64,
@@ -99,41 +76,19 @@ impl PlanarArm {
             modal_offset.push(n);
             n += l.modes().len();
         }
-        let mut arm = Self {
+        let integrals = links
+            .iter()
+            .map(|l| ShapeIntegrals::of(l, points))
+            .collect::<Result<_, _>>()?;
+        Ok(Self {
             links,
             joint: RevoluteJoint,
             gravity,
             quadrature,
             modal_offset,
             n,
-            mass_stations: Vec::new(),
-            cache: Mutex::new(None),
-        };
-        arm.mass_stations = arm.build_mass_stations();
-        Ok(arm)
-    }
-
-    fn build_mass_stations(&self) -> Vec<MassStation> {
-        let mut out = Vec::new();
-        for (i, link) in self.links.iter().enumerate() {
-            if link.has_distributed_mass() {
-                for (x, w) in self.quadrature.on(link.length()) {
-                    out.push(MassStation {
-                        station: self.station_unchecked(i, x),
-                        mass: w * link.mass_per_length(),
-                        inertia: w * link.rotary_inertia_per_length(),
-                    });
-                }
-            }
-            for m in link.point_masses() {
-                out.push(MassStation {
-                    station: self.station_unchecked(i, m.x),
-                    mass: m.mass,
-                    inertia: m.inertia,
-                });
-            }
-        }
-        out
+            integrals,
+        })
     }
 
     /// Number of generalized coordinates n.
@@ -161,7 +116,7 @@ impl PlanarArm {
     pub fn gravity(&self) -> f64 {
         self.gravity
     }
-    /// The quadrature rule used along every link.
+    /// The quadrature rule of the per-station reference.
     #[must_use]
     pub fn quadrature(&self) -> &GaussLegendre {
         &self.quadrature
@@ -171,16 +126,15 @@ impl PlanarArm {
     pub fn modal_offset(&self, i: usize) -> usize {
         self.modal_offset[i]
     }
+    /// The shape integrals of link `i`.
+    #[must_use]
+    pub fn shape_integrals(&self, i: usize) -> &ShapeIntegrals {
+        &self.integrals[i]
+    }
     /// Total mass of the arm (kg).
     #[must_use]
     pub fn mass(&self) -> f64 {
         self.links.iter().map(Link::mass).sum()
-    }
-    pub(crate) fn mass_stations(&self) -> &[MassStation] {
-        &self.mass_stations
-    }
-    pub(crate) fn projection_cache(&self) -> &Mutex<ProjectionCache> {
-        &self.cache
     }
 
     /// A line of names for q: `q1.., qb1_1..` (1-based, as in the design page).
@@ -215,7 +169,7 @@ impl PlanarArm {
         Ok(self.station_unchecked(link, x))
     }
 
-    fn station_unchecked(&self, link: usize, x: f64) -> Station {
+    pub(crate) fn station_unchecked(&self, link: usize, x: f64) -> Station {
         let modes = self.links[link].modes();
         Station {
             link,
@@ -237,12 +191,48 @@ impl PlanarArm {
         }
     }
 
+    /// Frames with room for this arm's links (for [`pose_in`](Self::pose_in)).
+    #[must_use]
+    pub fn frames(&self) -> Frames {
+        let nl = self.links.len();
+        Frames {
+            phi: Vec::with_capacity(nl),
+            cs: Vec::with_capacity(nl),
+            origin: Vec::with_capacity(nl + 1),
+        }
+    }
+
     /// The configuration at `q`.
     ///
     /// # Panics
     /// If `q.len() != self.n()`.
     #[must_use]
     pub fn pose<'a>(&'a self, q: &'a [f64]) -> Pose<'a> {
+        let mut frames = self.frames();
+        self.fill(q, &mut frames);
+        Pose {
+            arm: self,
+            q,
+            frames: Cow::Owned(frames),
+        }
+    }
+
+    /// The configuration at `q`, computed into `frames` (no allocation once `frames` has
+    /// room, e.g. from [`frames`](Self::frames)).
+    ///
+    /// # Panics
+    /// If `q.len() != self.n()`.
+    #[must_use]
+    pub fn pose_in<'a>(&'a self, q: &'a [f64], frames: &'a mut Frames) -> Pose<'a> {
+        self.fill(q, frames);
+        Pose {
+            arm: self,
+            q,
+            frames: Cow::Borrowed(frames),
+        }
+    }
+
+    fn fill(&self, q: &[f64], f: &mut Frames) {
         assert_eq!(
             q.len(),
             self.n,
@@ -250,28 +240,30 @@ impl PlanarArm {
             q.len(),
             self.n
         );
-        let nl = self.links.len();
-        let mut phi = Vec::with_capacity(nl);
-        let mut cs = Vec::with_capacity(nl);
-        let mut origin = Vec::with_capacity(nl + 1);
+        f.phi.clear();
+        f.cs.clear();
+        f.origin.clear();
         let (mut a, mut o) = (0.0, Vector2::zeros());
         for (i, link) in self.links.iter().enumerate() {
             a += q[i];
             let (s, c) = a.sin_cos();
-            phi.push(a);
-            cs.push((c, s));
-            origin.push(o);
+            f.phi.push(a);
+            f.cs.push((c, s));
+            f.origin.push(o);
             o += link.length() * Vector2::new(c, s);
         }
-        origin.push(o);
-        Pose {
-            arm: self,
-            q,
-            phi,
-            cs,
-            origin,
-        }
+        f.origin.push(o);
     }
+}
+
+/// The frames of an arm at one configuration: chord angles φ_i, their cosines and sines,
+/// and the joint positions. A [`Pose`] owns or borrows them.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Frames {
+    phi: Vec<f64>,
+    /// (cos φ_i, sin φ_i)
+    cs: Vec<(f64, f64)>,
+    origin: Vec<Vector2<f64>>,
 }
 
 /// The arm at one configuration q: chord angles, joint positions, deflections.
@@ -279,10 +271,7 @@ impl PlanarArm {
 pub struct Pose<'a> {
     arm: &'a PlanarArm,
     q: &'a [f64],
-    phi: Vec<f64>,
-    /// (cos φ_i, sin φ_i)
-    cs: Vec<(f64, f64)>,
-    origin: Vec<Vector2<f64>>,
+    frames: Cow<'a, Frames>,
 }
 
 impl<'a> Pose<'a> {
@@ -299,43 +288,43 @@ impl<'a> Pose<'a> {
     /// Angle φ_i of link i's chord from x₀.
     #[must_use]
     pub fn chord_angle(&self, i: usize) -> f64 {
-        self.phi[i]
+        self.frames.phi[i]
     }
     /// `R_i^0 v`: a vector in the coordinates of frame i expressed in frame 0.
     #[must_use]
     pub fn to_base(&self, i: usize, v: &Vector2<f64>) -> Vector2<f64> {
-        let (c, s) = self.cs[i];
+        let (c, s) = self.frames.cs[i];
         Vector2::new(c * v.x - s * v.y, s * v.x + c * v.y)
     }
     /// `R_0^i v`: a vector in frame 0 expressed in the coordinates of frame i.
     #[must_use]
     pub fn to_frame(&self, i: usize, v: &Vector2<f64>) -> Vector2<f64> {
-        let (c, s) = self.cs[i];
+        let (c, s) = self.frames.cs[i];
         Vector2::new(c * v.x + s * v.y, -s * v.x + c * v.y)
     }
     /// `R̄_0^i` (eq. 11): screws from frame 0 into the coordinates of frame i.
     #[must_use]
     pub fn screw_to_frame(&self, i: usize) -> CoordinateTransform {
-        let (c, s) = self.cs[i];
+        let (c, s) = self.frames.cs[i];
         CoordinateTransform::new(rot_z_cs(c, -s))
     }
     /// `R̄_i^0` (eq. 11): screws from the coordinates of frame i into frame 0.
     #[must_use]
     pub fn screw_to_base(&self, i: usize) -> CoordinateTransform {
-        let (c, s) = self.cs[i];
+        let (c, s) = self.frames.cs[i];
         CoordinateTransform::new(rot_z_cs(c, s))
     }
     /// `(cos, sin)` of the rotation `R_j^i` from frame j to frame i (angle φ_j − φ_i).
     #[must_use]
     pub fn relative_rotation(&self, j: usize, i: usize) -> (f64, f64) {
-        let ((cj, sj), (ci, si)) = (self.cs[j], self.cs[i]);
+        let ((cj, sj), (ci, si)) = (self.frames.cs[j], self.frames.cs[i]);
         (cj * ci + sj * si, sj * ci - cj * si)
     }
     /// Position of joint i (origin of frame i) in frame 0; `origin(n_links)` is the end of
     /// the last chord.
     #[must_use]
     pub fn origin(&self, i: usize) -> Vector2<f64> {
-        self.origin[i]
+        self.frames.origin[i]
     }
     /// The modal coordinates of link i.
     #[must_use]
@@ -369,7 +358,7 @@ impl<'a> Pose<'a> {
     /// Position of a station in frame 0.
     #[must_use]
     pub fn position(&self, s: &Station) -> Vector2<f64> {
-        self.origin[s.link] + self.to_base(s.link, &self.local(s))
+        self.frames.origin[s.link] + self.to_base(s.link, &self.local(s))
     }
     /// Position of a pin in frame 0 (a pin on a link sits on its deformed axis).
     ///
@@ -381,6 +370,38 @@ impl<'a> Pose<'a> {
             Pin::Ground(p) => p,
             Pin::Link { link, x } => self.position(&self.arm.station_unchecked(link, x)),
         }
+    }
+    /// `(cos φ_i, sin φ_i)`.
+    #[must_use]
+    pub fn cos_sin(&self, i: usize) -> (f64, f64) {
+        self.frames.cs[i]
+    }
+    /// `c_j = R_0^i (o_i − o_j)`: joint i seen from joint j, in the coordinates of frame i
+    /// (zero for j = i). The moment arm of a point r of link i about joint j is
+    /// `d_j = c_j + (x, w)` (eq. 35).
+    #[must_use]
+    pub fn chord_offset(&self, i: usize, j: usize) -> Vector2<f64> {
+        self.to_frame(i, &(self.frames.origin[i] - self.frames.origin[j]))
+    }
+    /// The non-zero columns of the velocity Jacobian `∂r/∂q` of a station in frame 0 (rows
+    /// `N_c` of eq. 72–73): `ẑ × (r − o_j)` for the joints j ≤ i of its link i, then
+    /// `ψ_k R_i ŷ` for the link's modes; `column(k, ∂r/∂q_k)` for each.
+    pub fn point_jacobian(&self, s: &Station, mut column: impl FnMut(usize, Vector2<f64>)) {
+        let i = s.link;
+        let r = self.position(s);
+        for j in 0..=i {
+            column(j, z_cross(&(r - self.frames.origin[j])));
+        }
+        let (c, sn) = self.frames.cs[i];
+        let o = self.arm.modal_offset[i];
+        for (k, psi) in s.psi.iter().enumerate() {
+            column(o + k, Vector2::new(-sn * psi, c * psi));
+        }
+    }
+    /// `out += (∂r/∂q)ᵀ f`: the generalized force of a force `f` (frame 0) at a station
+    /// (eq. 49).
+    pub fn add_point_force(&self, s: &Station, f: &Vector2<f64>, out: &mut [f64]) {
+        self.point_jacobian(s, |k, col| out[k] += col.dot(f));
     }
 }
 

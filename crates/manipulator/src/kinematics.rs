@@ -1,69 +1,67 @@
-//! [`ArmKinematics`]: the projection matrix of every mass-carrying station at one
-//! configuration, computed once and shared by M (eq. 42), E (eq. 44), G (eq. 45) and the
-//! reaction forces.
+//! [`ArmKinematics`]: the arm at one configuration, and the motion of each link's frame that
+//! the dynamics contract with the link's [`ShapeIntegrals`].
 //!
-//! The I-, C-field and reaction block of one arm all evaluate at the same q in one
-//! right-hand-side evaluation, so the arm keeps the projections of the configuration it was
-//! last asked for and hands them out again for the same q (compared bit for bit).
+//! # The velocity of a station as coefficients of its features
+//! A point of link i sits at `(x, w)` in frame i. With `c_j = R_0^i (o_i − o_j)`
+//! ([`Pose::chord_offset`]), its moment arm about joint j is `d_j = c_j + (x, w)`, and the
+//! columns of its projection (eq. 38) give the linear velocity (frame i) and the rotation
+//!
+//! ```text
+//! v = Σ_{j≤i} u_j ẑ × d_j + ẇ ŷ = (V_x − Ω w,  V_y + Ω x + ẇ)      ω = Ω + Σ_k θ_k u^b_k
+//! Ω = φ̇_i = Σ_{j≤i} u_j                V = Σ_{j≤i} u_j ẑ × c_j
+//! ```
+//!
+//! — linear in the features `φ = [1, x, ψ]` and `χ = [1, θ]` with coefficients that depend
+//! on q and u only. Turning joint k ≤ i turns the inboard joints the other way about it,
+//! `∂c_j/∂q_k = ẑ × (c_k − c_j)` for j < k, and a modal coordinate moves the point along y_i,
+//! so at constant u
+//!
+//! ```text
+//! ∂v/∂q_k   = δ_k = −Σ_{j<k} u_j (c_k − c_j)     (uniform along the link)
+//! ∂v/∂q^b_k = −Ω ψ_k x̂
+//! Ṗu = Σ_k u_k ∂v/∂q_k = (A_x − Ω ẇ, A_y)        A = Σ_{k≤i} u_k δ_k
+//! ```
+//!
+//! ([`LinkMotion`]). Every integral of a product of two such fields is a contraction with
+//! the Gram matrices G_A, G_I of the link.
+//!
+//! [`ShapeIntegrals`]: crate::ShapeIntegrals
 
-use std::sync::Arc;
+use nalgebra::Vector2;
 
-use crate::arm::{PlanarArm, Pose, Station};
-use crate::projection::Projection;
+use crate::arm::{z_cross, PlanarArm, Pose};
 
-/// One mass-carrying station at a configuration: its projection and its inertia.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct MassPoint<'a> {
-    pub(crate) projection: &'a Projection,
-    /// Mass (kg): `w·ρA` for a quadrature point, `m` for a point mass.
-    pub(crate) mass: f64,
-    /// Rotary inertia about z (kg·m²): `w·ρI`, or a point mass's own.
-    pub(crate) inertia: f64,
-    /// The station (link, x, mode values).
-    pub(crate) station: &'a Station,
-}
-
-/// The projections of the last configuration an arm was asked for.
-pub(crate) type ProjectionCache = Option<(Vec<f64>, Arc<Vec<Projection>>)>;
-
-/// The arm at configuration q with the projection matrix of each of its mass stations.
+/// The arm at configuration q.
 #[derive(Clone, Debug)]
 pub struct ArmKinematics<'a> {
     pub(crate) pose: Pose<'a>,
-    projections: Arc<Vec<Projection>>,
+}
+
+/// The motion of link i's frame at speeds u: `Ω = φ̇_i`, `V = Σ u_j ẑ × c_j`, `A = Σ u_k δ_k`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct LinkMotion {
+    pub(crate) omega: f64,
+    pub(crate) v: Vector2<f64>,
+    pub(crate) a: Vector2<f64>,
 }
 
 impl PlanarArm {
-    /// Kinematics at `q` (projections of every quadrature point and point mass).
+    /// Kinematics at `q`.
     ///
     /// # Panics
     /// If `q.len() != self.n()`.
     #[must_use]
     pub fn kinematics<'a>(&'a self, q: &'a [f64]) -> ArmKinematics<'a> {
-        let pose = self.pose(q);
-        // A poisoned cache only means another thread panicked while filling it: refill it.
-        let mut cache = self
-            .projection_cache()
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner);
-        let projections = match cache.as_ref() {
-            Some((key, p)) if key.as_slice() == q => p.clone(),
-            _ => {
-                let p: Arc<Vec<Projection>> = Arc::new(
-                    self.mass_stations()
-                        .iter()
-                        .map(|ms| Projection::at(&pose, &ms.station))
-                        .collect(),
-                );
-                *cache = Some((q.to_vec(), p.clone()));
-                p
-            }
-        };
-        ArmKinematics { pose, projections }
+        ArmKinematics::new(self.pose(q))
     }
 }
 
 impl<'a> ArmKinematics<'a> {
+    /// Kinematics at a pose (from [`PlanarArm::pose_in`] to avoid allocating).
+    #[must_use]
+    pub fn new(pose: Pose<'a>) -> Self {
+        Self { pose }
+    }
     /// The configuration.
     #[must_use]
     pub fn pose(&self) -> &Pose<'a> {
@@ -74,17 +72,27 @@ impl<'a> ArmKinematics<'a> {
     pub fn arm(&self) -> &'a PlanarArm {
         self.pose.arm()
     }
-    /// Every mass-carrying station with its projection.
-    pub(crate) fn points(&self) -> impl Iterator<Item = MassPoint<'_>> {
-        self.arm()
-            .mass_stations()
-            .iter()
-            .zip(self.projections.iter())
-            .map(|(ms, projection)| MassPoint {
-                projection,
-                mass: ms.mass,
-                inertia: ms.inertia,
-                station: &ms.station,
-            })
+    /// Modal coordinates and speeds of link i.
+    pub(crate) fn modal<'b>(&self, i: usize, u: &'b [f64]) -> (&[f64], &'b [f64]) {
+        let q = self.pose.modal(i);
+        let o = self.arm().modal_offset(i);
+        (q, &u[o..o + q.len()])
+    }
+
+    /// Ω, V and A of link i at speeds u (running sums over the joints j ≤ i).
+    pub(crate) fn link_motion(&self, i: usize, u: &[f64]) -> LinkMotion {
+        let (mut omega, mut s, mut a) = (0.0, Vector2::zeros(), Vector2::zeros());
+        for (k, uk) in u.iter().enumerate().take(i + 1) {
+            let ck = self.pose.chord_offset(i, k);
+            // δ_k = −(Σ_{j<k} u_j) c_k + Σ_{j<k} u_j c_j
+            a += *uk * (s - omega * ck);
+            omega += uk;
+            s += *uk * ck;
+        }
+        LinkMotion {
+            omega,
+            v: z_cross(&s),
+            a,
+        }
     }
 }

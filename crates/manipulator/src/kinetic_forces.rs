@@ -1,138 +1,104 @@
-//! The kinetic forces `E = ∂T/∂q` at constant u (eq. 44), the velocity-product term `Ṁ u`,
-//! and the accelerations `u̇ = M⁻¹(ṗ − Ṁ u)` of the momentum form (eq. 43).
+//! The kinetic forces `E = ∂T/∂q` at constant u (eq. 44), the velocity-product term `Ṁu`,
+//! and the accelerations `u̇ = M⁻¹(ṗ − Ṁu)` of the momentum form (eq. 43), contracted from
+//! the links' shape integrals.
 //!
-//! # ∂P/∂q, analytically
-//! A rigid column of the projection of a station on link i is `L_{j/i_e}^i = [ẑ; ẑ × d_j]`
-//! with the moment arm `d_j` of the station about joint j in frame i (see [`Projection`]);
-//! the modal columns do not depend on q. In frame i, turning joint k (j < k ≤ i) turns the
-//! inboard joints the other way about joint k, and a modal coordinate of link i moves the
-//! station along y_i:
+//! With `∂v/∂q_k = δ_k`, `∂v/∂q^b_k = −Ω ψ_k x̂` and `Ṗu = (A_x − Ω ẇ, A_y)`
+//! ([`kinematics`](crate::kinematics)), and the link's linear momentum
+//! `p = ∫ρA v = (m V_x − Ω ∫ρA w, m V_y + Ω s₁ + ∫ρA ẇ)`, link i adds (ω does not depend on q)
 //!
 //! ```text
-//! ∂d_j/∂q_k   = ẑ × (d_k − d_j)   for j < k ≤ i, else 0
-//! ∂d_j/∂q^b_k = ψ_k(x) ŷ           for every j ≤ i (modes of link i)
+//! E_k    += δ_k · p                                                   joints k ≤ i
+//! E_k    += −Ω (V_x a_k − Ω (Pq)_k)                                   modes k
+//! (Ṁu)_j += ∫ρA ((d/dt ∂v/∂u_j)·v + ∂v/∂u_j·Ṗu)
+//!         = −ċ_jy p_x + ċ_jx p_y − ∫ρA ẇ v_x
+//!           − c_jy (m A_x − Ω ∫ρA ẇ) − A_x ∫ρA w + Ω ∫ρA w ẇ + (m c_jx + s₁) A_y   joints j ≤ i
+//! (Ṁu)_k += a_k A_y                                                   modes k
 //! ```
 //!
-//! so with `v = Σ_j u_j ẑ × d_j + ẇ ŷ` the linear velocity of the station (frame i) and
-//! `φ̇_i = Σ_{j≤i} u_j`:
-//!
-//! ```text
-//! ∂v/∂q_k   = −Σ_{j<k} u_j (d_k − d_j)        ∂v/∂q^b_k = −φ̇_i ψ_k x̂
-//! E_k       = Σ m v·∂v/∂q_k                  (the rotation ω does not depend on q)
-//! Ṗ u       = Σ_k u_k ∂v/∂q_k =: a_v
-//! Ṁ u       = Σ (Ṗᵀ D t + Pᵀ D Ṗ u),  (Ṗᵀ D t)_j = m (ẑ × ḋ_j)·v
-//! ```
-//!
-//! The tests check E against central differences of T and Ṁu against differences of M.
-//!
-//! [`Projection`]: crate::Projection
+//! with `ċ_j = Σ_{j<k≤i} u_k ẑ × (c_k − c_j)` and `∫ρA ẇ v_x = V_x ∫ρA ẇ − Ω ∫ρA w ẇ`. The tests
+//! check E against central differences of T, Ṁu against differences of M, and both against
+//! the per-station [`reference`](crate::reference).
 
 use nalgebra::{DMatrix, DVector, Vector2};
 
 use crate::arm::z_cross;
-use crate::kinematics::{ArmKinematics, MassPoint};
-
-/// Velocity terms of one mass point at speeds u (frame of its link).
-pub(crate) struct PointVelocity {
-    /// Linear velocity v.
-    pub(crate) v: Vector2<f64>,
-    /// φ̇_i of the point's link.
-    pub(crate) phi_dot: f64,
-    /// `a_v = Ṗ u` (linear part; the angular part is zero).
-    pub(crate) a_v: Vector2<f64>,
-}
-
-impl MassPoint<'_> {
-    /// Velocity terms at speeds u; `on_partial(k, ∂v/∂q_k, v)` is called for every coordinate
-    /// k the velocity depends on (joints 1..=i of the chain, then the link's modes).
-    pub(crate) fn velocity_with(
-        &self,
-        u: &[f64],
-        modal_offset: usize,
-        mut on_partial: impl FnMut(usize, Vector2<f64>, &Vector2<f64>),
-    ) -> PointVelocity {
-        let t = self.projection.twist(u);
-        let v = Vector2::new(t[3], t[4]);
-        let d = self.projection.arms();
-        let i = d.len() - 1;
-        let phi_dot: f64 = u[..=i].iter().sum();
-        let mut a_v = Vector2::zeros();
-        for k in 1..=i {
-            let mut dv = Vector2::zeros();
-            for j in 0..k {
-                dv -= u[j] * (d[k] - d[j]);
-            }
-            a_v += u[k] * dv;
-            on_partial(k, dv, &v);
-        }
-        for (k, psi) in self.station.psi.iter().enumerate() {
-            let dv = Vector2::new(-phi_dot * psi, 0.0);
-            a_v += u[modal_offset + k] * dv;
-            on_partial(modal_offset + k, dv, &v);
-        }
-        PointVelocity { v, phi_dot, a_v }
-    }
-
-    pub(crate) fn velocity(&self, u: &[f64], modal_offset: usize) -> PointVelocity {
-        self.velocity_with(u, modal_offset, |_, _, _| ())
-    }
-}
+use crate::cholesky::Cholesky;
+use crate::kinematics::ArmKinematics;
 
 impl ArmKinematics<'_> {
     /// E = ∂T/∂q at constant u (eq. 44).
     #[must_use]
     pub fn kinetic_forces(&self, u: &[f64]) -> DVector<f64> {
-        self.kinetic_terms(u).0
+        let mut e = DVector::zeros(self.arm().n());
+        self.kinetic_terms_into(u, e.as_mut_slice(), None);
+        e
     }
 
     /// (E, Ṁ u) at speeds u.
     #[must_use]
     pub fn kinetic_terms(&self, u: &[f64]) -> (DVector<f64>, DVector<f64>) {
-        let arm = self.arm();
-        let n = arm.n();
-        let mut e = DVector::zeros(n);
-        let mut mdot_u = DVector::zeros(n);
-        for p in self.points() {
-            let i = p.projection.link();
-            let o = arm.modal_offset(i);
-            let pv = p.velocity_with(u, o, |k, dv, v| e[k] += p.mass * v.dot(&dv));
-            // Ṗᵀ D t
-            let d = p.projection.arms();
-            let w_dot: f64 = p
-                .station
-                .psi
-                .iter()
-                .enumerate()
-                .map(|(k, s)| s * u[o + k])
-                .sum();
-            for j in 0..=i {
-                let mut d_dot = Vector2::new(0.0, w_dot);
-                for k in j + 1..=i {
-                    d_dot += u[k] * z_cross(&(d[k] - d[j]));
-                }
-                mdot_u[j] += p.mass * z_cross(&d_dot).dot(&pv.v);
-            }
-            // Pᵀ D Ṗu
-            for (c, col) in &p.projection.cols {
-                mdot_u[*c] += p.mass * (col[3] * pv.a_v.x + col[4] * pv.a_v.y);
-            }
-        }
+        let n = self.arm().n();
+        let (mut e, mut mdot_u) = (DVector::zeros(n), DVector::zeros(n));
+        self.kinetic_terms_into(u, e.as_mut_slice(), Some(mdot_u.as_mut_slice()));
         (e, mdot_u)
     }
 
+    /// E into `e` and, if given, Ṁu into `mdot_u` (each of length n), without allocating.
+    pub fn kinetic_terms_into(&self, u: &[f64], e: &mut [f64], mut mdot_u: Option<&mut [f64]>) {
+        let arm = self.arm();
+        e.fill(0.0);
+        if let Some(md) = mdot_u.as_deref_mut() {
+            md.fill(0.0);
+        }
+        for i in 0..arm.n_links() {
+            let g = arm.shape_integrals(i);
+            let o = arm.modal_offset(i);
+            let (qb, ub) = self.modal(i, u);
+            let d = g.deflection_moments(qb, ub);
+            let f = self.link_motion(i, u);
+            let (mass, s1, om) = (g.mass(), g.first_moment(), f.omega);
+            let p = Vector2::new(mass * f.v.x - om * d.w, mass * f.v.y + om * s1 + d.w_dot);
+            let s_total = Vector2::new(f.v.y, -f.v.x); // Σ_{j≤i} u_j c_j
+            let (mut u_before, mut s_before) = (0.0, Vector2::zeros());
+            for (k, uk) in u.iter().enumerate().take(i + 1) {
+                let ck = self.pose.chord_offset(i, k);
+                e[k] += (s_before - u_before * ck).dot(&p);
+                u_before += uk;
+                s_before += *uk * ck;
+                if let Some(md) = mdot_u.as_deref_mut() {
+                    let c_dot = z_cross(&((s_total - s_before) - (om - u_before) * ck));
+                    let wdot_vx = f.v.x * d.w_dot - om * d.w_w_dot;
+                    md[k] += -c_dot.y * p.x + c_dot.x * p.y
+                        - wdot_vx
+                        - ck.y * (mass * f.a.x - om * d.w_dot)
+                        - f.a.x * d.w
+                        + om * d.w_w_dot
+                        + (mass * ck.x + s1) * f.a.y;
+                }
+            }
+            for k in 0..qb.len() {
+                let a = g.mode_mass(k);
+                e[o + k] -= om * (f.v.x * a - om * g.mode_times_deflection(k, qb));
+                if let Some(md) = mdot_u.as_deref_mut() {
+                    md[o + k] += a * f.a.y;
+                }
+            }
+        }
+    }
+
     /// Accelerations `u̇ = M⁻¹(ṗ − Ṁ u)` given the momentum rate ṗ (eq. 43), or `None` if M is
-    /// singular.
+    /// not positive definite.
     #[must_use]
     pub fn accelerations(&self, u: &[f64], p_dot: &DVector<f64>) -> Option<DVector<f64>> {
+        let n = self.arm().n();
         let (_, mdot_u) = self.kinetic_terms(u);
-        solve(self.mass_matrix(), &(p_dot - mdot_u))
-    }
-}
-
-/// Solve `M x = b` for symmetric positive definite M (Cholesky, LU as a fallback).
-pub(crate) fn solve(m: DMatrix<f64>, b: &DVector<f64>) -> Option<DVector<f64>> {
-    match m.clone().cholesky() {
-        Some(c) => Some(c.solve(b)),
-        None => m.lu().solve(b),
+        let mut factor = Cholesky::new(n);
+        let mut m = DMatrix::zeros(n, n);
+        self.mass_matrix_into(&mut m);
+        let mut x = p_dot - mdot_u;
+        factor.factor(&m).then(|| {
+            factor.solve_in_place(x.as_mut_slice());
+            x
+        })
     }
 }

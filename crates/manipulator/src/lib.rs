@@ -13,15 +13,19 @@
 //! ## The arm (section 3.1)
 //! [`Link`]s (rigid, Euler–Bernoulli beams with assumed [`ModeShape`]s — [`SineMode`] by
 //! default —, point masses, the payload pendulum) joined by [`RevoluteJoint`]s with
-//! chord-to-chord angles form a [`PlanarArm`]; [`PlanarArm::pose`] gives its [`Pose`] and
-//! [`Projection`] the projection matrices (eqs. 24, 38, 73), integrated along the links with
-//! [`GaussLegendre`] quadrature.
+//! chord-to-chord angles form a [`PlanarArm`]; [`PlanarArm::pose`] gives its [`Pose`]
+//! (or [`PlanarArm::pose_in`], into reusable [`Frames`]) and [`Projection`] the projection
+//! matrices (eqs. 24, 38, 73). Each link's [`ShapeIntegrals`] — the Gram matrices of its
+//! station features, in closed form for sine modes, else by [`GaussLegendre`] quadrature —
+//! are computed once, when the arm is built.
 //!
 //! ## Dynamics (section 3.2)
 //! [`PlanarArm::kinematics`] → [`ArmKinematics`]: the mass matrix
 //! ([`ArmKinematics::mass_matrix`], eq. 42), `E = ∂T/∂q` ([`ArmKinematics::kinetic_forces`],
-//! eq. 44), gravity ([`ArmKinematics::gravity_forces`], eqs. 45–48), the accelerations; the
-//! stiffness ([`PlanarArm::stiffness_matrix`], eq. 51).
+//! eq. 44), gravity ([`ArmKinematics::gravity_forces`], eqs. 45–48), the accelerations, each
+//! a contraction of the shape integrals, O(modes²) per link, with `_into` forms that do not
+//! allocate; the stiffness ([`PlanarArm::stiffness_matrix`], eq. 51). [`reference`] keeps
+//! the per-station quadrature sums as the tests' reference.
 //!
 //! ## Actuators and lumped masses (sections 3.3, 4.2)
 //! [`LinearActuator`] between [`Pin`]s: length from the deformed pins and `τ_b = ∂l/∂q`
@@ -40,6 +44,7 @@
 
 pub mod actuator;
 pub mod arm;
+mod cholesky;
 pub mod elements;
 pub mod error;
 pub mod gravity;
@@ -54,13 +59,15 @@ pub mod pin;
 pub mod projection;
 pub mod quadrature;
 pub mod reactions;
+pub mod reference;
 pub mod register;
 pub mod scene;
 pub mod screw;
+pub mod shape_integrals;
 pub mod stiffness;
 
 pub use actuator::LinearActuator;
-pub use arm::{PlanarArm, Pose, Station};
+pub use arm::{Frames, PlanarArm, Pose, Station};
 pub use elements::{
     lumped_masses, ActuatorTransformer, ArmCompliance, ArmDamping, ArmInertia, ArmReactions,
     LumpedGravity, LumpedMassTransformer,
@@ -71,10 +78,11 @@ pub use kinematics::ArmKinematics;
 pub use link::{Link, PointMass};
 pub use lumped_mass::LumpedMass;
 pub use mode_shape::{ModeShape, SineMode};
-pub use pin::Pin;
+pub use pin::{Pin, PinPoint};
 pub use projection::Projection;
 pub use quadrature::GaussLegendre;
 pub use reactions::PointLoad;
 pub use register::register;
 pub use scene::{ArmScene, LumpedMassModel, SceneError};
 pub use screw::{CoordinateTransform, ReferenceTransform, ScrewTransform};
+pub use shape_integrals::ShapeIntegrals;

@@ -11,8 +11,7 @@ use nalgebra::DMatrix;
 
 use crate::arm::{PlanarArm, Pose};
 use crate::error::ManipulatorError;
-use crate::pin::Pin;
-use crate::projection::Projection;
+use crate::pin::{Pin, PinPoint};
 
 /// A point mass at a pin on a link.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -39,15 +38,14 @@ impl PlanarArm {
     /// The velocity Jacobian of a pin in frame 0 (2×n; zero for a ground pin).
     #[must_use]
     pub fn pin_jacobian(&self, pose: &Pose<'_>, pin: &Pin) -> DMatrix<f64> {
-        match *pin {
-            Pin::Ground(_) => DMatrix::zeros(2, self.n()),
-            Pin::Link { link, x } => match self.station(link, x) {
-                Ok(s) => Projection::at(pose, &s)
-                    .in_base_frame(pose)
-                    .velocity_jacobian(),
-                Err(_) => DMatrix::zeros(2, self.n()),
-            },
+        let mut j = DMatrix::zeros(2, self.n());
+        if let Ok(PinPoint::Station(s)) = self.resolve_pin(pin) {
+            pose.point_jacobian(&s, |k, col| {
+                j[(0, k)] = col.x;
+                j[(1, k)] = col.y;
+            });
         }
+        j
     }
 
     /// `J_c` of eq. 71 (2m × n) for pins `pins`.

@@ -1,28 +1,25 @@
-//! The mass matrix M(q) (eq. 42) and the kinetic energy T (eq. 41).
+//! The mass matrix M(q) (eq. 42) and the kinetic energy T (eq. 41), contracted from the
+//! links' shape integrals.
 //!
-//! `M = Σ_i ∫_0^{L_i} Pᵀ D_e P dx + Σ_point masses Pᵀ D P`, with `D_e = diag(ρJ, ρA I)`
-//! (eq. 40). For planar motion only `ω_z` is non-zero, so the rotational block enters through
-//! its zz entry, the rotary inertia per length ρI; the in-plane entries are irrelevant and
-//! set equal to it. The integral is the link's Gauss–Legendre rule (see [`quadrature`]).
+//! `M = Σ_i ∫ Pᵀ D_e P dx + Σ_point masses Pᵀ D P` with `D_e = diag(ρI, ρA I)` (eq. 40; planar
+//! motion uses only the zz entry of the rotational block). The columns of a point of link i
+//! are `∂v/∂u_j = ẑ × d_j = (−(c_jy + w), c_jx + x)`, `∂ω/∂u_j = 1` for its joints j ≤ i and
+//! `∂v/∂u^b_k = ψ_k ŷ`, `∂ω/∂u^b_k = θ_k` for its modes (see [`kinematics`](crate::kinematics)),
+//! so link i adds
 //!
-//! [`quadrature`]: crate::quadrature
+//! ```text
+//! M_jl += m c_j·c_l + (c_jx + c_lx) s₁ + s₂ + (c_jy + c_ly) ∫ρA w + ∫ρA w² + ∫ρI     j, l ≤ i
+//! M_jk += c_jx a_k + b_k + ∫ρI θ_k                                                   mode k
+//! M_kl += P_kl + ∫ρI θ_k θ_l
+//! ```
+//!
+//! with `m = ∫ρA`, `s₁ = ∫ρA x`, `s₂ = ∫ρA x²`, `a = ∫ρA ψ`, `b = ∫ρA x ψ`, `P = ∫ρA ψψᵀ`
+//! (point masses included: [`ShapeIntegrals`](crate::ShapeIntegrals)). With
+//! `v = (V_x − Ω w, V_y + Ω x + ẇ)` and `ω = Ω + θ·u^b`, `T = ½∫ρA |v|² + ½∫ρI ω²` likewise.
 
 use nalgebra::DMatrix;
 
-use crate::kinematics::{ArmKinematics, MassPoint};
-use crate::screw::Screw;
-
-/// `D t` for the inertia of a mass point (eq. 40).
-pub(crate) fn inertia_times(p: &MassPoint<'_>, t: &Screw) -> Screw {
-    Screw::new(
-        p.inertia * t[0],
-        p.inertia * t[1],
-        p.inertia * t[2],
-        p.mass * t[3],
-        p.mass * t[4],
-        p.mass * t[5],
-    )
-}
+use crate::kinematics::ArmKinematics;
 
 impl ArmKinematics<'_> {
     /// M(q) of eq. 42 (n×n, symmetric positive definite for a well-posed arm).
@@ -30,39 +27,76 @@ impl ArmKinematics<'_> {
     pub fn mass_matrix(&self) -> DMatrix<f64> {
         let n = self.arm().n();
         let mut m = DMatrix::zeros(n, n);
-        for p in self.points() {
-            let cols = &p.projection.cols;
-            let (j, mass) = (p.inertia, p.mass);
-            for (a, ca) in cols {
-                let d = [
-                    j * ca[0],
-                    j * ca[1],
-                    j * ca[2],
-                    mass * ca[3],
-                    mass * ca[4],
-                    mass * ca[5],
-                ];
-                for (b, cb) in cols {
-                    m[(*a, *b)] += d[0] * cb[0]
-                        + d[1] * cb[1]
-                        + d[2] * cb[2]
-                        + d[3] * cb[3]
-                        + d[4] * cb[4]
-                        + d[5] * cb[5];
-                }
-            }
-        }
+        self.mass_matrix_into(&mut m);
         m
     }
 
-    /// T = ½ Σ tᵀ D t (eq. 41) at speeds `u`.
+    /// M(q) into `m` (n×n), without allocating.
+    ///
+    /// # Panics
+    /// If `m` is not n×n.
+    pub fn mass_matrix_into(&self, m: &mut DMatrix<f64>) {
+        let arm = self.arm();
+        assert_eq!(m.shape(), (arm.n(), arm.n()), "M must be n×n");
+        m.fill(0.0);
+        for i in 0..arm.n_links() {
+            let g = arm.shape_integrals(i);
+            let o = arm.modal_offset(i);
+            let qb = self.pose.modal(i);
+            let d = g.deflection_moments(qb, qb);
+            let (mass, s1, s2) = (g.mass(), g.first_moment(), g.second_moment());
+            let common = s2 + d.w_w + g.rotary();
+            for j in 0..=i {
+                let cj = self.pose.chord_offset(i, j);
+                for l in 0..=j {
+                    let cl = self.pose.chord_offset(i, l);
+                    let v = mass * cj.dot(&cl) + (cj.x + cl.x) * s1 + (cj.y + cl.y) * d.w + common;
+                    m[(j, l)] += v;
+                    if l != j {
+                        m[(l, j)] += v;
+                    }
+                }
+                for k in 0..qb.len() {
+                    let v = cj.x * g.mode_mass(k) + g.mode_moment(k) + g.rotary_mode(k);
+                    m[(j, o + k)] += v;
+                    m[(o + k, j)] += v;
+                }
+            }
+            for k in 0..qb.len() {
+                for l in 0..qb.len() {
+                    m[(o + k, o + l)] += g.mode_product(k, l) + g.rotary_product(k, l);
+                }
+            }
+        }
+    }
+
+    /// T = ½ uᵀ M u (eq. 41) at speeds `u`.
     #[must_use]
     pub fn kinetic_energy(&self, u: &[f64]) -> f64 {
-        self.points()
-            .map(|p| {
-                let t = p.projection.twist(u);
-                0.5 * t.dot(&inertia_times(&p, &t))
-            })
-            .sum()
+        let arm = self.arm();
+        let mut t = 0.0;
+        for i in 0..arm.n_links() {
+            let g = arm.shape_integrals(i);
+            let (qb, ub) = self.modal(i, u);
+            let d = g.deflection_moments(qb, ub);
+            let f = self.link_motion(i, u);
+            let (om, v) = (f.omega, f.v);
+            // ∫ρA |v|², v = (V_x − Ω w, V_y + Ω x + ẇ)
+            let translation = g.mass() * v.norm_squared() - 2.0 * v.x * om * d.w
+                + om * om * (d.w_w + g.second_moment())
+                + d.w_dot_w_dot
+                + 2.0 * v.y * (om * g.first_moment() + d.w_dot)
+                + 2.0 * om * d.x_w_dot;
+            // ∫ρI ω², ω = Ω + θ·u^b
+            let mut rotation = g.rotary() * om * om;
+            for (k, uk) in ub.iter().enumerate() {
+                rotation += 2.0 * om * g.rotary_mode(k) * uk;
+                for (l, ul) in ub.iter().enumerate() {
+                    rotation += uk * g.rotary_product(k, l) * ul;
+                }
+            }
+            t += 0.5 * (translation + rotation);
+        }
+        t
     }
 }

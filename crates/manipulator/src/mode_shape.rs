@@ -19,6 +19,12 @@ pub trait ModeShape: Debug + Send + Sync {
     fn slope(&self, x: f64) -> f64;
     /// `ψ''(x)` (1/m²): the curvature, for the strain energy (eq. 50).
     fn curvature(&self, x: f64) -> f64;
+    /// `Some(κ)` if `ψ(x) = sin(κx)` exactly: the link's shape integrals are then taken in
+    /// closed form ([`ShapeIntegrals`](crate::ShapeIntegrals)); `None` (the default): by
+    /// quadrature.
+    fn sine_wavenumber(&self) -> Option<f64> {
+        None
+    }
 }
 
 /// The k-th hinged–hinged mode of a uniform beam of length L: `ψ_k(x) = sin(kπx/L)`
@@ -52,6 +58,9 @@ impl ModeShape for SineMode {
     }
     fn curvature(&self, x: f64) -> f64 {
         -self.wavenumber * self.wavenumber * (self.wavenumber * x).sin()
+    }
+    fn sine_wavenumber(&self) -> Option<f64> {
+        Some(self.wavenumber)
     }
 }
 

@@ -1,9 +1,13 @@
 //! Pins: attachment points of actuators and lumped masses (design page, Fig. 3).
 //!
 //! A pin is fixed in frame 0 (the crane base) or sits on the *deformed* axis of a link at
-//! distance x along its chord, i.e. at `(x, w(x))` in the link's frame.
+//! distance x along its chord, i.e. at `(x, w(x))` in the link's frame. Resolved on an arm
+//! once ([`PinPoint`]), its position and generalized forces need no allocation.
 
 use nalgebra::Vector2;
+
+use crate::arm::{PlanarArm, Pose, Station};
+use crate::error::ManipulatorError;
 
 /// An attachment point.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,5 +33,54 @@ impl Pin {
     #[must_use]
     pub fn on_link(link: usize, x: f64) -> Self {
         Self::Link { link, x }
+    }
+}
+
+/// A pin resolved on an arm ([`PlanarArm::resolve_pin`]): a ground point, or a station with
+/// its mode values.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PinPoint {
+    /// Fixed in frame 0.
+    Ground(Vector2<f64>),
+    /// On a link's deformed axis.
+    Station(Station),
+}
+
+impl PinPoint {
+    /// The station, for a pin on a link.
+    #[must_use]
+    pub fn station(&self) -> Option<&Station> {
+        match self {
+            Self::Ground(_) => None,
+            Self::Station(s) => Some(s),
+        }
+    }
+}
+
+impl PlanarArm {
+    /// Resolve `pin` on this arm (checks it lies on the arm).
+    pub fn resolve_pin(&self, pin: &Pin) -> Result<PinPoint, ManipulatorError> {
+        self.check_pin(pin)?;
+        match *pin {
+            Pin::Ground(p) => Ok(PinPoint::Ground(p)),
+            Pin::Link { link, x } => Ok(PinPoint::Station(self.station(link, x)?)),
+        }
+    }
+}
+
+impl Pose<'_> {
+    /// Position of a resolved pin in frame 0.
+    #[must_use]
+    pub fn pin_point_position(&self, pin: &PinPoint) -> Vector2<f64> {
+        match pin {
+            PinPoint::Ground(p) => *p,
+            PinPoint::Station(s) => self.position(s),
+        }
+    }
+    /// `out += (∂r/∂q)ᵀ f` for a force `f` (frame 0) at a resolved pin (zero on the ground).
+    pub fn add_pin_force(&self, pin: &PinPoint, f: &Vector2<f64>, out: &mut [f64]) {
+        if let PinPoint::Station(s) = pin {
+            self.add_point_force(s, f, out);
+        }
     }
 }

@@ -1,37 +1,37 @@
 //! Reaction forces in the passive joints (section 5, eqs. 84–98), in the design page's
-//! convention.
+//! convention, contracted from the links' shape integrals.
 //!
-//! The method of auxiliary generalized speeds: give joint j a fictitious translation along
-//! x_j and y_j. It moves every point outboard of the joint with the twist columns of the
-//! auxiliary projection (eqs. 88–89)
-//!
-//! ```text
-//! L_{j/i_e}^i = V_{i_e,j}^{i,j} Π L_{j/j}^j,   L_{j/j}^j = [L_x L_y]   (pure translations)
-//! ```
-//!
-//! and the reaction is what the motion of the outboard bodies requires beyond the applied
-//! forces on them:
+//! The method of auxiliary generalized speeds gives joint j a fictitious translation along
+//! x_j and y_j: the auxiliary projection columns `V_{i_e,j}^{i,j} Π [L_x L_y]` (eqs. 88–89) of
+//! every point outboard of the joint are the pure translations x_j, y_j. So eq. 97,
+//! `ρ = M_r ϑ − G_r − τ_r F` written out per point, is Newton's law for everything outboard
+//! of joint j, in the axes of frame j:
 //!
 //! ```text
-//! ρ_j = Σ_{outboard} P_rᵀ D a  −  Σ_{outboard} P_rᵀ Π (w^{(g)} + w^{ext})
+//! ρ_j = R_0^j ( Σ_{i≥j} ∫ρA (a − g⃗) dx  −  Σ_{loads on links ≥ j} f )
 //! ```
 //!
-//! with `a` the inertial acceleration of each mass point (`P u̇ + Ṗ u` plus the transport
-//! term `φ̇ ẑ × v` of its link frame: the full acceleration, velocity products included) —
-//! eq. 97 with `M_r ϑ`, `G_r` and `τ_r F` written out per point. `ρ_{2j−1}, ρ_{2j}` is the
-//! force that the inboard body exerts on link j through joint j, in the axes of frame j
-//! (x along link j's chord; for the pendulum from the pivot to the payload). A pendulum at
-//! rest gives `ρ = (−m g, 0)`. Internal forces — strain, modal damping, joint torques — do not
-//! enter. External forces are the actuator forces on their pins and, when the lumped cylinder
-//! masses hang on springs, the spring–damper forces on the pins; masses that move rigidly with
-//! a pin (the paper's eqs. 91–94, or the "rigidly attached" scene) are point masses.
+//! with `a` the inertial acceleration of each mass point: `P u̇ + Ṗ u` plus the transport
+//! term `Ω ẑ × v` of its link frame. All three are linear in the features φ = [1, x, ψ]
+//! ([`kinematics`](crate::kinematics)), so per link, with `p` its linear momentum
+//! (see [`kinetic_forces`](crate::kinetic_forces)) and a dot on the quantities at speeds u̇,
+//!
+//! ```text
+//! ∫ρA a = (m V̇_x − Ω̇ ∫ρA w, m V̇_y + Ω̇ s₁ + ∫ρA ẅ) + (m A_x − Ω ∫ρA ẇ, m A_y) + Ω ẑ × p.
+//! ```
+//!
+//! `ρ_{2j−1}, ρ_{2j}` is the force that the inboard body exerts on link j through joint j,
+//! in the axes of frame j (x along link j's chord; for the pendulum from the pivot to the
+//! payload). A pendulum at rest gives `ρ = (−m g, 0)`. Internal forces — strain, modal
+//! damping, joint torques — do not enter. External forces are the actuator forces on their
+//! pins and, when the lumped cylinder masses hang on springs, the spring–damper forces on the
+//! pins; masses that move rigidly with a pin (the paper's eqs. 91–94, or the "rigidly
+//! attached" scene) are point masses.
 
-use nalgebra::{DVector, Vector2, Vector3};
+use nalgebra::{DVector, Vector2};
 
 use crate::arm::{z_cross, Station};
-use crate::kinematics::{ArmKinematics, MassPoint};
-use crate::projection::Projection;
-use crate::screw::{line_x, line_y, rot_z_cs, swap, wrench, Screw, ScrewTransform};
+use crate::kinematics::ArmKinematics;
 
 /// A force (frame 0, N) applied at a station of the arm.
 #[derive(Clone, Debug, PartialEq)]
@@ -42,38 +42,26 @@ pub struct PointLoad {
     pub force: Vector2<f64>,
 }
 
-impl MassPoint<'_> {
-    /// Inertial acceleration `[0 0 α a_x a_y 0]` of the point, in its link's frame.
-    pub(crate) fn acceleration(&self, u: &[f64], u_dot: &[f64], modal_offset: usize) -> Screw {
-        let pv = self.velocity(u, modal_offset);
-        let pa = self.projection.twist(u_dot);
-        let a = Vector2::new(pa[3], pa[4]) + pv.a_v + pv.phi_dot * z_cross(&pv.v);
-        Screw::new(0.0, 0.0, pa[2], a.x, a.y, 0.0)
-    }
-}
-
 impl ArmKinematics<'_> {
-    /// The auxiliary projection columns `V_{i_e,j}^{i,j} Π [L_x L_y]` (eq. 88) of joint j for
-    /// a point of link i at `r` (frame 0).
-    fn auxiliary_columns(&self, i: usize, j: usize, r: &Vector2<f64>) -> [Screw; 2] {
-        let p = self.pose.to_frame(j, &(self.pose.origin(j) - r));
-        let (c, s) = self.pose.relative_rotation(j, i);
-        let v = ScrewTransform::new(rot_z_cs(c, s), Vector3::new(p.x, p.y, 0.0));
-        [v.apply(&swap(&line_x())), v.apply(&swap(&line_y()))]
+    /// Inertial acceleration of a station (frame of its link).
+    fn station_acceleration(&self, s: &Station, u: &[f64], u_dot: &[f64]) -> Vector2<f64> {
+        let i = s.link;
+        let (qb, ub) = self.modal(i, u);
+        let (_, udb) = self.modal(i, u_dot);
+        let dot = |v: &[f64]| -> f64 { s.psi.iter().zip(v).map(|(p, x)| p * x).sum() };
+        let (w, w_dot, w_ddot) = (dot(qb), dot(ub), dot(udb));
+        let (f, fd) = (self.link_motion(i, u), self.link_motion(i, u_dot));
+        let v = Vector2::new(f.v.x - f.omega * w, f.v.y + f.omega * s.x + w_dot);
+        let pa = Vector2::new(fd.v.x - fd.omega * w, fd.v.y + fd.omega * s.x + w_ddot);
+        let a_v = Vector2::new(f.a.x - f.omega * w_dot, f.a.y);
+        pa + a_v + f.omega * z_cross(&v)
     }
 
     /// Inertial acceleration of a station in frame 0 at speeds `u` and accelerations `u_dot`.
     #[must_use]
     pub fn point_acceleration(&self, s: &Station, u: &[f64], u_dot: &[f64]) -> Vector2<f64> {
-        let projection = Projection::at(&self.pose, s);
-        let mp = MassPoint {
-            projection: &projection,
-            mass: 1.0,
-            inertia: 0.0,
-            station: s,
-        };
-        let a = mp.acceleration(u, u_dot, self.arm().modal_offset(s.link));
-        self.pose.to_base(s.link, &Vector2::new(a[3], a[4]))
+        self.pose
+            .to_base(s.link, &self.station_acceleration(s, u, u_dot))
     }
 
     /// The reaction forces ρ (2 per joint, eq. 97) at speeds `u` and accelerations `u_dot`,
@@ -86,52 +74,60 @@ impl ArmKinematics<'_> {
         loads: &[PointLoad],
         rigid_masses: &[(Station, f64)],
     ) -> DVector<f64> {
-        let arm = self.arm();
-        let g = arm.gravity();
-        let mut rho = DVector::zeros(2 * arm.n_links());
-        let extra: Vec<Projection> = rigid_masses
-            .iter()
-            .map(|(s, _)| Projection::at(&self.pose, s))
-            .collect();
-        let extra = rigid_masses
-            .iter()
-            .zip(&extra)
-            .map(|((s, m), projection)| MassPoint {
-                projection,
-                mass: *m,
-                inertia: 0.0,
-                station: s,
-            });
-        for p in self.points().chain(extra) {
-            let i = p.projection.link();
-            let r = self.pose.position(p.station);
-            let a = p.acceleration(u, u_dot, arm.modal_offset(i));
-            let d_a = crate::mass_matrix::inertia_times(&p, &a);
-            let gw = self.pose.screw_to_frame(i).apply(&wrench(
-                Vector3::new(0.0, -p.mass * g, 0.0),
-                Vector3::zeros(),
-            ));
-            let pi_gw = swap(&gw);
-            for j in 0..=i {
-                for (c, col) in self.auxiliary_columns(i, j, &r).iter().enumerate() {
-                    rho[2 * j + c] += col.dot(&d_a) - col.dot(&pi_gw);
-                }
-            }
-        }
-        for load in loads {
-            let i = load.station.link;
-            let r = self.pose.position(&load.station);
-            let w = self.pose.screw_to_frame(i).apply(&wrench(
-                Vector3::new(load.force.x, load.force.y, 0.0),
-                Vector3::zeros(),
-            ));
-            let pi_w = swap(&w);
-            for j in 0..=i {
-                for (c, col) in self.auxiliary_columns(i, j, &r).iter().enumerate() {
-                    rho[2 * j + c] -= col.dot(&pi_w);
-                }
-            }
-        }
+        let mut rho = DVector::zeros(2 * self.arm().n_links());
+        self.reactions_into(
+            u,
+            u_dot,
+            loads.iter().map(|l| (&l.station, l.force)),
+            rigid_masses,
+            rho.as_mut_slice(),
+        );
         rho
+    }
+
+    /// As [`reactions`](Self::reactions), into `rho` (length 2 n_links), with the loads as
+    /// (station, force in frame 0) pairs; no allocation.
+    pub fn reactions_into<'s>(
+        &self,
+        u: &[f64],
+        u_dot: &[f64],
+        loads: impl IntoIterator<Item = (&'s Station, Vector2<f64>)>,
+        rigid_masses: &[(Station, f64)],
+        rho: &mut [f64],
+    ) {
+        let arm = self.arm();
+        let weight = Vector2::new(0.0, arm.gravity());
+        rho.fill(0.0);
+        // Σ (m a − m g⃗) of link i (frame 0), onto every joint j ≤ i.
+        let add = |i: usize, f: Vector2<f64>, rho: &mut [f64]| {
+            for j in 0..=i {
+                let fj = self.pose.to_frame(j, &f);
+                rho[2 * j] += fj.x;
+                rho[2 * j + 1] += fj.y;
+            }
+        };
+        for i in 0..arm.n_links() {
+            let g = arm.shape_integrals(i);
+            let (qb, ub) = self.modal(i, u);
+            let (_, udb) = self.modal(i, u_dot);
+            let d = g.deflection_moments(qb, ub);
+            let w_ddot: f64 = (0..qb.len()).map(|k| g.mode_mass(k) * udb[k]).sum();
+            let (f, fd) = (self.link_motion(i, u), self.link_motion(i, u_dot));
+            let (mass, s1, om) = (g.mass(), g.first_moment(), f.omega);
+            let p = Vector2::new(mass * f.v.x - om * d.w, mass * f.v.y + om * s1 + d.w_dot);
+            let ma = Vector2::new(
+                mass * fd.v.x - fd.omega * d.w,
+                mass * fd.v.y + fd.omega * s1 + w_ddot,
+            ) + Vector2::new(mass * f.a.x - om * d.w_dot, mass * f.a.y)
+                + om * z_cross(&p);
+            add(i, self.pose.to_base(i, &ma) + mass * weight, rho);
+        }
+        for (s, m) in rigid_masses {
+            let a = self.point_acceleration(s, u, u_dot);
+            add(s.link, *m * (a + weight), rho);
+        }
+        for (s, f) in loads {
+            add(s.link, -f, rho);
+        }
     }
 }

@@ -8,7 +8,7 @@
 //! q0 = [0, "-2*pi/3", "pi/6"]         # joint angles, then modal coordinates (missing: 0)
 //! u0 = []                             # speeds (missing: 0)
 //! damping = [0, 0, "r_p", "r_e", "r_e", "r_e", "r_e", "r_e", "r_e"]   # diag D (missing: 0)
-//! quadrature_points = 16              # Gauss–Legendre points per link
+//! quadrature_points = 16              # Gauss–Legendre points per link (reference; non-sine modes)
 //! links = [
 //!   { type = "beam", length = "L1", E = "E", rho = "rho", A = "A", I = "I", modes = 3 },
 //!   { type = "beam", length = "L2", E = "E", rho = "rho", A = "A", I = "I", modes = 3 },

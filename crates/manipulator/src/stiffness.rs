@@ -2,7 +2,10 @@
 //!
 //! `U_i = ½ E_i I_i ∫ (∂θ_i/∂x)² dx` with `θ_i' = w_i'' = Σ_k ψ_k'' q_k^b`, so
 //! `K = Σ_i E_i I_i ∫ Θ_i'ᵀ Θ_i' dx` is block diagonal over the links' modal coordinates and
-//! zero on the joint angles. For sine modes `K_kk = EI (kπ/L)⁴ L/2` and the modes decouple.
+//! zero on the joint angles; the blocks are the links' [`ShapeIntegrals::bending`]. For sine
+//! modes `K_kk = EI (kπ/L)⁴ L/2` and the modes decouple.
+//!
+//! [`ShapeIntegrals::bending`]: crate::ShapeIntegrals::bending
 
 use nalgebra::DMatrix;
 
@@ -14,17 +17,10 @@ impl PlanarArm {
     pub fn stiffness_matrix(&self) -> DMatrix<f64> {
         let n = self.n();
         let mut k = DMatrix::zeros(n, n);
-        for (i, link) in self.links().iter().enumerate() {
+        for i in 0..self.n_links() {
+            let b = self.shape_integrals(i).bending();
             let o = self.modal_offset(i);
-            let modes = link.modes();
-            for (x, w) in self.quadrature().on(link.length()) {
-                let c: Vec<f64> = modes.iter().map(|m| m.curvature(x)).collect();
-                for a in 0..modes.len() {
-                    for b in 0..modes.len() {
-                        k[(o + a, o + b)] += link.bending_stiffness() * w * c[a] * c[b];
-                    }
-                }
-            }
+            k.view_mut((o, o), b.shape()).copy_from(b);
         }
         k
     }
@@ -32,7 +28,12 @@ impl PlanarArm {
     /// Strain energy `½ qᵀ K q` (eq. 50) given K.
     #[must_use]
     pub fn strain_energy(k: &DMatrix<f64>, q: &[f64]) -> f64 {
-        let q = nalgebra::DVector::from_column_slice(q);
-        0.5 * q.dot(&(k * &q))
+        let mut e = 0.0;
+        for (a, qa) in q.iter().enumerate() {
+            for (b, qb) in q.iter().enumerate() {
+                e += qa * k[(a, b)] * qb;
+            }
+        }
+        0.5 * e
     }
 }

@@ -7,7 +7,8 @@
 //! the generalized forces `τ = τ_b F_c` (eq. 69), and f_in₂ is the length rates `l̇ = τ_bᵀu`.
 //! The configuration is read from the I-field's `<arm>.q`. Publishes, per actuator c (numbered
 //! from 1, or from [`numbered_from`](ActuatorTransformer::numbered_from)): `l{c}` (m) and
-//! `ldot{c}` (m/s, computed from the flow on port 1 whatever the bond's direction).
+//! `ldot{c}` (m/s, computed from the flow on port 1 whatever the bond's direction), each in a
+//! stage of its own (the right-hand side skips `ldot{c}` unless an element reads it).
 
 use std::cell::RefCell;
 use std::sync::Arc;
@@ -17,21 +18,44 @@ use bondgraph::{
 };
 use nalgebra::DMatrix;
 
+use super::last_argument::LastArgument;
 use super::mtf_law;
 use crate::actuator::LinearActuator;
-use crate::arm::PlanarArm;
-
-/// τ_b and the lengths at one configuration q.
-type Modulus = (Vec<f64>, DMatrix<f64>, Vec<f64>);
+use crate::arm::{Frames, PlanarArm};
+use crate::pin::PinPoint;
 
 /// The actuator MTF of a [`PlanarArm`].
 #[derive(Debug)]
 pub struct ActuatorTransformer {
     arm: Arc<PlanarArm>,
-    acts: Vec<LinearActuator>,
+    /// Per actuator, its pins (a, b) resolved on the arm.
+    pins: Vec<(PinPoint, PinPoint)>,
     q_signal: String,
     first: usize,
-    cache: RefCell<Option<Modulus>>,
+    ws: RefCell<Modulus>,
+}
+
+/// τ_b and the lengths at the last configuration q.
+#[derive(Debug)]
+struct Modulus {
+    q: LastArgument,
+    frames: Frames,
+    tau: DMatrix<f64>,
+    lengths: Vec<f64>,
+}
+
+impl Modulus {
+    fn update(&mut self, arm: &PlanarArm, pins: &[(PinPoint, PinPoint)], q: &[f64]) {
+        if self.q.is_same(q) {
+            return;
+        }
+        let pose = arm.pose_in(self.q.get(), &mut self.frames);
+        let n = arm.n();
+        for (c, (a, b)) in pins.iter().enumerate() {
+            let column = &mut self.tau.as_mut_slice()[c * n..(c + 1) * n];
+            self.lengths[c] = pose.actuator_length(a, b, column);
+        }
+    }
 }
 
 impl ActuatorTransformer {
@@ -48,15 +72,23 @@ impl ActuatorTransformer {
                 message: "needs at least one actuator".into(),
             });
         }
+        let mut pins = Vec::with_capacity(acts.len());
         for a in &acts {
             arm.check_actuator(a, q0)?;
+            pins.push((arm.resolve_pin(&a.a)?, arm.resolve_pin(&a.b)?));
         }
+        let n = arm.n();
         Ok(Self {
+            ws: RefCell::new(Modulus {
+                q: LastArgument::new(n),
+                frames: arm.frames(),
+                tau: DMatrix::zeros(n, acts.len()),
+                lengths: vec![0.0; acts.len()],
+            }),
             arm,
-            acts,
+            pins,
             q_signal: q_signal.to_owned(),
             first: 1,
-            cache: RefCell::new(None),
         })
     }
 
@@ -65,19 +97,6 @@ impl ActuatorTransformer {
     pub fn numbered_from(mut self, first: usize) -> Self {
         self.first = first;
         self
-    }
-
-    /// `(τ_b, lengths)` at q.
-    fn with_modulus<R>(&self, q: &[f64], f: impl FnOnce(&DMatrix<f64>, &[f64]) -> R) -> R {
-        let mut cache = self.cache.borrow_mut();
-        if let Some((_, t, l)) = cache.as_ref().filter(|c| c.0 == q) {
-            return f(t, l);
-        }
-        let pose = self.arm.pose(q);
-        let t = self.arm.actuator_jacobian(&pose, &self.acts);
-        let l = self.acts.iter().map(|a| a.length(&pose)).collect();
-        let (_, t, l) = cache.insert((q.to_vec(), t, l));
-        f(t, l)
     }
 }
 
@@ -88,7 +107,7 @@ impl Element for ActuatorTransformer {
     fn ports(&self) -> Ports {
         Ports::Fixed(vec![
             PortSpec::new("1", self.arm.n()),
-            PortSpec::new("2", self.acts.len()),
+            PortSpec::new("2", self.pins.len()),
         ])
     }
     fn causal_rule(&self, _: usize) -> CausalRule {
@@ -101,38 +120,44 @@ impl Element for ActuatorTransformer {
         }]
     }
     fn signal_outputs(&self) -> Vec<SignalSpec> {
-        let c = self.first..self.first + self.acts.len();
+        let c = self.first..self.first + self.pins.len();
         c.clone()
             .map(|c| SignalSpec::scalar(&format!("l{c}")))
             .chain(c.map(|c| SignalSpec::scalar(&format!("ldot{c}"))))
             .collect()
     }
     fn stages(&self, _: &[PortCausality]) -> Vec<Stage> {
-        let n = self.acts.len();
-        let mut stages = mtf_law::stages(&(n..2 * n).collect::<Vec<_>>());
+        let n = self.pins.len();
+        let mut stages = mtf_law::stages();
         stages.push(Stage {
             writes: (0..n).map(Slot::Output).collect(),
             reads: vec![Slot::Input(0)],
         });
+        stages.push(Stage {
+            writes: (n..2 * n).map(Slot::Output).collect(),
+            reads: vec![Slot::Flow(0), Slot::Input(0)],
+        });
         stages
     }
     fn eval(&self, stage: usize, io: &mut Io<'_>) {
-        let q = io.input(0).to_vec();
-        let n = self.acts.len();
-        self.with_modulus(&q, |t, l| match stage {
-            0 => mtf_law::set_effort(io, t),
-            1 => {
-                mtf_law::set_flow(io, t);
-                for c in 0..n {
-                    let ldot: f64 = (0..t.nrows()).map(|i| t[(i, c)] * io.flow(0)[i]).sum();
-                    io.set_y(n + c, 0, ldot);
-                }
-            }
-            _ => {
-                for (c, lc) in l.iter().enumerate() {
+        let mut ws = self.ws.borrow_mut();
+        ws.update(&self.arm, &self.pins, io.input(0));
+        let n = self.pins.len();
+        match stage {
+            0 => mtf_law::set_effort(io, &ws.tau),
+            1 => mtf_law::set_flow(io, &ws.tau),
+            2 => {
+                for (c, lc) in ws.lengths.iter().enumerate() {
                     io.set_y(c, 0, *lc);
                 }
             }
-        });
+            _ => {
+                for c in 0..n {
+                    let column = ws.tau.column(c);
+                    let ldot: f64 = column.iter().zip(io.flow(0)).map(|(t, f)| t * f).sum();
+                    io.set_y(n + c, 0, ldot);
+                }
+            }
+        }
     }
 }

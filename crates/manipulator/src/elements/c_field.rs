@@ -4,14 +4,18 @@
 //! generalized coordinates. The displacement q is the I-field's state, read as the signal
 //! `<arm>.q`, so the field stores the potential energy `V(q) = V_g(q) + ½ qᵀK q` without
 //! states of its own: the power on its port, `eᵀ u = (−G + K q)ᵀ q̇ = dV/dt`, is exactly the
-//! rate of V. Causality is fixed (effort out). Publishes `V` (J).
+//! rate of V. Causality is fixed (effort out). Publishes `V` (J) in a stage of its own, which
+//! the right-hand side skips unless another element reads it.
 
+use std::cell::RefCell;
 use std::sync::Arc;
 
 use bondgraph::{CausalRule, Element, Io, PortCausality, PortSpec, Ports, SignalSpec, Slot, Stage};
 use nalgebra::{DMatrix, DVector};
 
-use crate::arm::PlanarArm;
+use super::last_argument::LastArgument;
+use crate::arm::{Frames, PlanarArm};
+use crate::kinematics::ArmKinematics;
 
 /// The C-field of a [`PlanarArm`].
 #[derive(Debug)]
@@ -19,14 +23,40 @@ pub struct ArmCompliance {
     arm: Arc<PlanarArm>,
     k: DMatrix<f64>,
     q_signal: String,
+    ws: RefCell<Workspace>,
+}
+
+/// G(q) and V_g(q) at the last configuration.
+#[derive(Debug)]
+struct Workspace {
+    q: LastArgument,
+    frames: Frames,
+    g: Vec<f64>,
+    v_g: f64,
+}
+
+impl Workspace {
+    fn update(&mut self, arm: &PlanarArm, q: &[f64]) {
+        if !self.q.is_same(q) {
+            let kin = ArmKinematics::new(arm.pose_in(self.q.get(), &mut self.frames));
+            self.v_g = kin.gravity_into(&mut self.g);
+        }
+    }
 }
 
 impl ArmCompliance {
     /// The C-field of `arm`, reading the configuration from the signal `q_signal` (`arm.q`).
     #[must_use]
     pub fn new(arm: Arc<PlanarArm>, q_signal: &str) -> Self {
+        let n = arm.n();
         Self {
             k: arm.stiffness_matrix(),
+            ws: RefCell::new(Workspace {
+                q: LastArgument::new(n),
+                frames: arm.frames(),
+                g: vec![0.0; n],
+                v_g: 0.0,
+            }),
             arm,
             q_signal: q_signal.to_owned(),
         }
@@ -64,17 +94,32 @@ impl Element for ArmCompliance {
         vec![SignalSpec::scalar("V")]
     }
     fn stages(&self, _: &[PortCausality]) -> Vec<Stage> {
-        vec![Stage {
-            writes: vec![Slot::Effort(0), Slot::Output(0)],
-            reads: vec![Slot::Input(0)],
-        }]
+        vec![
+            Stage {
+                writes: vec![Slot::Effort(0)],
+                reads: vec![Slot::Input(0)],
+            },
+            Stage {
+                writes: vec![Slot::Output(0)],
+                reads: vec![Slot::Input(0)],
+            },
+        ]
     }
-    fn eval(&self, _: usize, io: &mut Io<'_>) {
-        let q = io.input(0).to_vec();
-        let (e, v) = self.effort_and_potential(&q);
-        for (k, ek) in e.iter().enumerate() {
-            io.set_e(0, k, *ek);
+    fn eval(&self, stage: usize, io: &mut Io<'_>) {
+        let mut ws = self.ws.borrow_mut();
+        ws.update(&self.arm, io.input(0));
+        let q = ws.q.get();
+        if stage == 0 {
+            for (k, gk) in ws.g.iter().enumerate() {
+                let kq: f64 = q
+                    .iter()
+                    .enumerate()
+                    .map(|(l, ql)| self.k[(k, l)] * ql)
+                    .sum();
+                io.set_e(0, k, kq - gk);
+            }
+        } else {
+            io.set_y(0, 0, ws.v_g + PlanarArm::strain_energy(&self.k, q));
         }
-        io.set_y(0, 0, v);
     }
 }

@@ -23,19 +23,27 @@
 //! (1-based, the design page's names); `qb{i}_{k}`/`ub{i}_{k}` exist for k = 1, 2, 3 even
 //! when link i has fewer modes (a mode that is not modelled has zero amplitude), so result
 //! columns survive a change of the number of modes.
+//!
+//! # Stages
+//! Stage 0 writes u (flow and signal); `derivatives` adds E. Both use one factorisation of
+//! M(q) per state, which stage 1 (`udot`, from the effort received) reuses. Stages 2 (`T`,
+//! `x_e{i}`, `y_e{i}`, `w{i}_mid`) and 3 (the named coordinates) write only signals, so the
+//! right-hand side skips them unless another element reads them. Nothing allocates after
+//! construction: M, its factor and the vectors live in a workspace.
 
 use std::cell::RefCell;
 use std::sync::Arc;
 
 use bondgraph::{
-    CausalRule, Element, Io, ParamError, PortCausality, PortSpec, Ports, SignalSpec, Slot, Stage,
-    StateSpec,
+    component_names, CausalRule, Element, Io, ParamError, PortCausality, PortSpec, Ports,
+    SignalSpec, Slot, Stage, StateSpec,
 };
 use nalgebra::{DMatrix, DVector};
 
-use crate::arm::PlanarArm;
-use crate::kinetic_forces::solve;
-use bondgraph::component_names;
+use super::last_argument::LastArgument;
+use crate::arm::{Frames, PlanarArm, Station};
+use crate::cholesky::Cholesky;
+use crate::kinematics::ArmKinematics;
 
 /// The I-field of a [`PlanarArm`].
 #[derive(Debug)]
@@ -44,18 +52,24 @@ pub struct ArmInertia {
     q0: Vec<f64>,
     p0: Vec<f64>,
     p_nominal: Vec<f64>,
-    mid: Vec<Option<crate::arm::Station>>,
-    cache: RefCell<Option<Motion>>,
+    mid: Vec<Option<Station>>,
+    /// (coordinate name, speed name, index in q or `None` for an unmodelled mode).
+    named: Vec<(String, String, Option<usize>)>,
+    ws: RefCell<Motion>,
 }
 
-/// Everything computed at one state (p, q).
+/// Everything computed at one state (p, q), in buffers allocated once.
 #[derive(Debug)]
 struct Motion {
-    key: Vec<f64>,
+    state: LastArgument,
+    frames: Frames,
     m: DMatrix<f64>,
-    u: DVector<f64>,
-    e: DVector<f64>,
-    mdot_u: DVector<f64>,
+    factor: Cholesky,
+    u: Vec<f64>,
+    e: Vec<f64>,
+    mdot_u: Vec<f64>,
+    mdot_u_valid: bool,
+    udot: Vec<f64>,
     kinetic: f64,
 }
 
@@ -66,26 +80,63 @@ const OUT_LINKS: usize = 3;
 /// Named coordinates `qb{i}_{k}` are published at least up to this k.
 const NAMED_MODES: usize = 3;
 
-impl ArmInertia {
-    /// (coordinate name, speed name, index in q or `None` for an unmodelled mode).
-    fn named_coordinates(&self) -> Vec<(String, String, Option<usize>)> {
-        let mut v: Vec<(String, String, Option<usize>)> = (1..=self.arm.n_links())
-            .map(|i| (format!("q{i}"), format!("u{i}"), Some(i - 1)))
-            .collect();
-        for (i, l) in self.arm.links().iter().enumerate() {
-            let n_modes = l.modes().len();
-            for k in 1..=n_modes.max(NAMED_MODES) {
-                let index = (k <= n_modes).then(|| self.arm.modal_offset(i) + k - 1);
-                v.push((
-                    format!("qb{}_{k}", i + 1),
-                    format!("ub{}_{k}", i + 1),
-                    index,
-                ));
-            }
+impl Motion {
+    fn new(arm: &PlanarArm) -> Self {
+        let n = arm.n();
+        Self {
+            state: LastArgument::new(2 * n),
+            frames: arm.frames(),
+            m: DMatrix::zeros(n, n),
+            factor: Cholesky::new(n),
+            u: vec![0.0; n],
+            e: vec![0.0; n],
+            mdot_u: vec![0.0; n],
+            mdot_u_valid: false,
+            udot: vec![0.0; n],
+            kinetic: 0.0,
         }
-        v
     }
 
+    /// M, its factor, u = M⁻¹p, E and T at the state x = (p, q), unless x is the last one.
+    fn update(&mut self, arm: &PlanarArm, x: &[f64]) {
+        if self.state.is_same(x) {
+            return;
+        }
+        let Self {
+            state,
+            frames,
+            m,
+            factor,
+            u,
+            e,
+            mdot_u_valid,
+            kinetic,
+            ..
+        } = self;
+        let (p, q) = state.get().split_at(arm.n());
+        let kin = ArmKinematics::new(arm.pose_in(q, frames));
+        kin.mass_matrix_into(m);
+        factor.factor(m);
+        u.copy_from_slice(p);
+        factor.solve_in_place(u);
+        kin.kinetic_terms_into(u, e, None);
+        *kinetic = 0.5 * u.iter().zip(p).map(|(a, b)| a * b).sum::<f64>();
+        *mdot_u_valid = false;
+    }
+
+    /// Ṁu at the last state.
+    fn velocity_products(&mut self, arm: &PlanarArm) {
+        if self.mdot_u_valid {
+            return;
+        }
+        let q = &self.state.get()[arm.n()..];
+        let kin = ArmKinematics::new(arm.pose_in(q, &mut self.frames));
+        kin.kinetic_terms_into(&self.u, &mut self.udot, Some(&mut self.mdot_u));
+        self.mdot_u_valid = true;
+    }
+}
+
+impl ArmInertia {
     /// The I-field of `arm` starting at configuration `q0` with speeds `u0` (p₀ = M(q₀)u₀).
     pub fn new(arm: Arc<PlanarArm>, q0: Vec<f64>, u0: Vec<f64>) -> Result<Self, ParamError> {
         let n = arm.n();
@@ -105,7 +156,7 @@ impl ArmInertia {
             }
         }
         let m = arm.kinematics(&q0).mass_matrix();
-        if m.clone().cholesky().is_none() {
+        if !Cholesky::new(n).factor(&m) {
             return Err(ParamError::Shape {
                 param: "links".into(),
                 message: "the mass matrix is singular: every coordinate needs inertia (a massless link without a point mass?)".into(),
@@ -126,13 +177,28 @@ impl ArmInertia {
                     .flatten()
             })
             .collect();
+        let mut named: Vec<(String, String, Option<usize>)> = (1..=arm.n_links())
+            .map(|i| (format!("q{i}"), format!("u{i}"), Some(i - 1)))
+            .collect();
+        for (i, l) in arm.links().iter().enumerate() {
+            let n_modes = l.modes().len();
+            for k in 1..=n_modes.max(NAMED_MODES) {
+                let index = (k <= n_modes).then(|| arm.modal_offset(i) + k - 1);
+                named.push((
+                    format!("qb{}_{k}", i + 1),
+                    format!("ub{}_{k}", i + 1),
+                    index,
+                ));
+            }
+        }
         Ok(Self {
+            ws: RefCell::new(Motion::new(&arm)),
             arm,
             q0,
             p0,
             p_nominal,
             mid,
-            cache: RefCell::new(None),
+            named,
         })
     }
 
@@ -142,30 +208,8 @@ impl ArmInertia {
         &self.arm
     }
 
-    fn motion<R>(&self, x: &[f64], f: impl FnOnce(&Motion) -> R) -> R {
-        let mut cache = self.cache.borrow_mut();
-        if let Some(m) = cache.as_ref().filter(|m| m.key == x) {
-            return f(m);
-        }
-        f(cache.insert(self.compute(x)))
-    }
-
-    fn compute(&self, x: &[f64]) -> Motion {
-        let n = self.arm.n();
-        let (p, q) = x.split_at(n);
-        let kin = self.arm.kinematics(q);
-        let m = kin.mass_matrix();
-        let pv = DVector::from_column_slice(p);
-        let u = solve(m.clone(), &pv).unwrap_or_else(|| DVector::from_element(n, f64::NAN));
-        let (e, mdot_u) = kin.kinetic_terms(u.as_slice());
-        Motion {
-            key: x.to_vec(),
-            kinetic: 0.5 * u.dot(&pv),
-            m,
-            u,
-            e,
-            mdot_u,
-        }
+    fn first_named_output(&self) -> usize {
+        OUT_LINKS + 3 * self.arm.n_links()
     }
 }
 
@@ -194,7 +238,6 @@ impl Element for ArmInertia {
     }
     fn signal_outputs(&self) -> Vec<SignalSpec> {
         let n = self.arm.n();
-        let named = self.named_coordinates();
         let mut out = vec![
             SignalSpec {
                 name: "u".into(),
@@ -211,73 +254,99 @@ impl Element for ArmInertia {
             out.push(SignalSpec::scalar(&format!("y_e{i}")));
             out.push(SignalSpec::scalar(&format!("w{i}_mid")));
         }
-        for (q, u, _) in &named {
+        for (q, u, _) in &self.named {
             out.push(SignalSpec::scalar(q));
             out.push(SignalSpec::scalar(u));
         }
         out
     }
     fn stages(&self, _: &[PortCausality]) -> Vec<Stage> {
-        let n_out = OUT_LINKS + 3 * self.arm.n_links() + 2 * self.named_coordinates().len();
-        let mut writes = vec![Slot::Flow(0), Slot::Output(OUT_U), Slot::Output(OUT_T)];
-        writes.extend((OUT_LINKS..n_out).map(Slot::Output));
+        let first = self.first_named_output();
+        let mut geometry = vec![Slot::Output(OUT_T)];
+        geometry.extend((OUT_LINKS..first).map(Slot::Output));
         vec![
             Stage {
-                writes,
+                writes: vec![Slot::Flow(0), Slot::Output(OUT_U)],
                 reads: Vec::new(),
             },
             Stage {
                 writes: vec![Slot::Output(OUT_UDOT)],
                 reads: vec![Slot::Effort(0)],
             },
+            Stage {
+                writes: geometry,
+                reads: Vec::new(),
+            },
+            Stage {
+                writes: (first..first + 2 * self.named.len())
+                    .map(Slot::Output)
+                    .collect(),
+                reads: Vec::new(),
+            },
         ]
     }
     fn eval(&self, stage: usize, io: &mut Io<'_>) {
-        let x = io.states().to_vec();
         let n = self.arm.n();
-        if stage == 0 {
-            let (u, t) = self.motion(&x, |m| (m.u.clone(), m.kinetic));
-            for k in 0..n {
-                io.set_f_in(0, k, u[k]);
-                io.set_y(OUT_U, k, u[k]);
+        let mut ws = self.ws.borrow_mut();
+        ws.update(&self.arm, io.states());
+        match stage {
+            0 => {
+                for (k, &uk) in ws.u.iter().enumerate() {
+                    io.set_f_in(0, k, uk);
+                    io.set_y(OUT_U, k, uk);
+                }
             }
-            io.set_y(OUT_T, 0, t);
-            let pose = self.arm.pose(&x[n..]);
-            for i in 0..self.arm.n_links() {
-                let end = pose.origin(i + 1);
-                let w = self.mid[i].as_ref().map_or(0.0, |s| pose.deflection(s));
-                io.set_y(OUT_LINKS + 3 * i, 0, end.x);
-                io.set_y(OUT_LINKS + 3 * i + 1, 0, end.y);
-                io.set_y(OUT_LINKS + 3 * i + 2, 0, w);
+            1 => {
+                ws.velocity_products(&self.arm);
+                let Motion {
+                    factor,
+                    e,
+                    mdot_u,
+                    udot,
+                    ..
+                } = &mut *ws;
+                for k in 0..n {
+                    udot[k] = io.e(0, k) + e[k] - mdot_u[k];
+                }
+                factor.solve_in_place(udot);
+                for (k, &a) in udot.iter().enumerate() {
+                    io.set_y(OUT_UDOT, k, a);
+                }
             }
-            let first = OUT_LINKS + 3 * self.arm.n_links();
-            for (j, (_, _, index)) in self.named_coordinates().iter().enumerate() {
-                let (q, v) = index.map_or((0.0, 0.0), |k| (x[n + k], u[k]));
-                io.set_y(first + 2 * j, 0, q);
-                io.set_y(first + 2 * j + 1, 0, v);
+            2 => {
+                io.set_y(OUT_T, 0, ws.kinetic);
+                let Motion { state, frames, .. } = &mut *ws;
+                let pose = self.arm.pose_in(&state.get()[n..], frames);
+                for i in 0..self.arm.n_links() {
+                    let end = pose.origin(i + 1);
+                    let w = self.mid[i].as_ref().map_or(0.0, |s| pose.deflection(s));
+                    io.set_y(OUT_LINKS + 3 * i, 0, end.x);
+                    io.set_y(OUT_LINKS + 3 * i + 1, 0, end.y);
+                    io.set_y(OUT_LINKS + 3 * i + 2, 0, w);
+                }
             }
-        } else {
-            let e = DVector::from_column_slice(io.effort(0));
-            let udot = self.motion(&x, |m| {
-                solve(m.m.clone(), &(e + &m.e - &m.mdot_u))
-                    .unwrap_or_else(|| DVector::from_element(n, f64::NAN))
-            });
-            for k in 0..n {
-                io.set_y(OUT_UDOT, k, udot[k]);
+            _ => {
+                let first = self.first_named_output();
+                for (j, (_, _, index)) in self.named.iter().enumerate() {
+                    let (q, v) = index.map_or((0.0, 0.0), |k| (ws.state.get()[n + k], ws.u[k]));
+                    io.set_y(first + 2 * j, 0, q);
+                    io.set_y(first + 2 * j + 1, 0, v);
+                }
             }
         }
     }
     fn derivatives(&self, io: &Io<'_>, dx: &mut [f64]) {
         let n = self.arm.n();
-        let x = io.states().to_vec();
-        self.motion(&x, |m| {
-            for k in 0..n {
-                dx[k] = io.e(0, k) + m.e[k];
-                dx[n + k] = m.u[k];
-            }
-        });
+        let mut ws = self.ws.borrow_mut();
+        ws.update(&self.arm, io.states());
+        for k in 0..n {
+            dx[k] = io.e(0, k) + ws.e[k];
+            dx[n + k] = ws.u[k];
+        }
     }
     fn stored_energy(&self, x: &[f64]) -> Option<f64> {
-        Some(self.motion(x, |m| m.kinetic))
+        let mut ws = self.ws.borrow_mut();
+        ws.update(&self.arm, x);
+        Some(ws.kinetic)
     }
 }

@@ -15,17 +15,26 @@ use bondgraph::{
 };
 use nalgebra::DMatrix;
 
+use super::last_argument::LastArgument;
 use super::mtf_law;
-use crate::arm::PlanarArm;
-use crate::pin::Pin;
+use crate::arm::{Frames, PlanarArm, Station};
+use crate::pin::{Pin, PinPoint};
 
 /// The lumped-mass MTF of a [`PlanarArm`].
 #[derive(Debug)]
 pub struct LumpedMassTransformer {
     arm: Arc<PlanarArm>,
-    pins: Vec<Pin>,
+    stations: Vec<Station>,
     q_signal: String,
-    cache: RefCell<Option<(Vec<f64>, DMatrix<f64>)>>,
+    ws: RefCell<Modulus>,
+}
+
+/// `J_cᵀ` at the last configuration q.
+#[derive(Debug)]
+struct Modulus {
+    q: LastArgument,
+    frames: Frames,
+    jt: DMatrix<f64>,
 }
 
 impl LumpedMassTransformer {
@@ -37,31 +46,47 @@ impl LumpedMassTransformer {
                 message: "needs at least one pin".into(),
             });
         }
+        let mut stations = Vec::with_capacity(pins.len());
         for pin in &pins {
-            if matches!(pin, Pin::Ground(_)) {
-                return Err(ParamError::Shape {
-                    param: "lumped_masses".into(),
-                    message: "a lumped mass must sit on a link".into(),
-                });
+            match arm.resolve_pin(pin)? {
+                PinPoint::Station(s) => stations.push(s),
+                PinPoint::Ground(_) => {
+                    return Err(ParamError::Shape {
+                        param: "lumped_masses".into(),
+                        message: "a lumped mass must sit on a link".into(),
+                    })
+                }
             }
-            arm.check_pin(pin)?;
         }
+        let n = arm.n();
         Ok(Self {
+            ws: RefCell::new(Modulus {
+                q: LastArgument::new(n),
+                frames: arm.frames(),
+                jt: DMatrix::zeros(n, 2 * pins.len()),
+            }),
             arm,
-            pins,
+            stations,
             q_signal: q_signal.to_owned(),
-            cache: RefCell::new(None),
         })
     }
+}
 
-    /// `J_cᵀ` at q.
-    fn with_modulus<R>(&self, q: &[f64], f: impl FnOnce(&DMatrix<f64>) -> R) -> R {
-        let mut cache = self.cache.borrow_mut();
-        if let Some((_, t)) = cache.as_ref().filter(|c| c.0 == q) {
-            return f(t);
+impl Modulus {
+    /// `J_cᵀ` (n × 2m, eq. 71) at q: column 2k, 2k+1 the x, y velocity Jacobian of pin k.
+    fn update(&mut self, arm: &PlanarArm, stations: &[Station], q: &[f64]) {
+        if self.q.is_same(q) {
+            return;
         }
-        let jc = self.arm.lumped_mass_jacobian(&self.arm.pose(q), &self.pins);
-        f(&cache.insert((q.to_vec(), jc.transpose())).1)
+        let pose = arm.pose_in(self.q.get(), &mut self.frames);
+        let jt = &mut self.jt;
+        jt.fill(0.0);
+        for (k, s) in stations.iter().enumerate() {
+            pose.point_jacobian(s, |i, col| {
+                jt[(i, 2 * k)] = col.x;
+                jt[(i, 2 * k + 1)] = col.y;
+            });
+        }
     }
 }
 
@@ -72,7 +97,7 @@ impl Element for LumpedMassTransformer {
     fn ports(&self) -> Ports {
         Ports::Fixed(vec![
             PortSpec::new("1", self.arm.n()),
-            PortSpec::new("2", 2 * self.pins.len()),
+            PortSpec::new("2", 2 * self.stations.len()),
         ])
     }
     fn causal_rule(&self, _: usize) -> CausalRule {
@@ -85,16 +110,15 @@ impl Element for LumpedMassTransformer {
         }]
     }
     fn stages(&self, _: &[PortCausality]) -> Vec<Stage> {
-        mtf_law::stages(&[])
+        mtf_law::stages()
     }
     fn eval(&self, stage: usize, io: &mut Io<'_>) {
-        let q = io.input(0).to_vec();
-        self.with_modulus(&q, |t| {
-            if stage == 0 {
-                mtf_law::set_effort(io, t);
-            } else {
-                mtf_law::set_flow(io, t);
-            }
-        });
+        let mut ws = self.ws.borrow_mut();
+        ws.update(&self.arm, &self.stations, io.input(0));
+        if stage == 0 {
+            mtf_law::set_effort(io, &ws.jt);
+        } else {
+            mtf_law::set_flow(io, &ws.jt);
+        }
     }
 }

@@ -19,6 +19,7 @@
 mod actuator_mtf;
 mod c_field;
 mod i_field;
+mod last_argument;
 mod lumped_gravity;
 mod lumped_mass_mtf;
 mod lumped_masses;

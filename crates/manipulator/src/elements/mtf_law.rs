@@ -5,18 +5,16 @@
 use bondgraph::{Io, Slot, Stage};
 use nalgebra::DMatrix;
 
-/// Stage 0 writes e₁ from e₂, stage 1 writes f₂ (and `flow_outputs`) from f₁; both read
-/// the modulating signal input 0.
-pub(crate) fn stages(flow_outputs: &[usize]) -> Vec<Stage> {
-    let mut flow_writes = vec![Slot::Flow(1)];
-    flow_writes.extend(flow_outputs.iter().map(|&o| Slot::Output(o)));
+/// Stage 0 writes e₁ from e₂, stage 1 writes f₂ from f₁; both read the modulating signal
+/// input 0.
+pub(crate) fn stages() -> Vec<Stage> {
     vec![
         Stage {
             writes: vec![Slot::Effort(0)],
             reads: vec![Slot::Effort(1), Slot::Input(0)],
         },
         Stage {
-            writes: flow_writes,
+            writes: vec![Slot::Flow(1)],
             reads: vec![Slot::Flow(0), Slot::Input(0)],
         },
     ]

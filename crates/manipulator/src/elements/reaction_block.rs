@@ -11,16 +11,17 @@
 //!
 //! [`ArmKinematics::reactions`]: crate::ArmKinematics::reactions
 
+use std::cell::RefCell;
 use std::sync::Arc;
 
 use bondgraph::{CausalRule, Element, Io, ParamError, Ports, SignalSpec};
 use nalgebra::Vector2;
 
 use crate::actuator::LinearActuator;
-use crate::arm::{PlanarArm, Station};
+use crate::arm::{Frames, PlanarArm, Station};
+use crate::kinematics::ArmKinematics;
 use crate::lumped_mass::LumpedMass;
-use crate::pin::Pin;
-use crate::reactions::PointLoad;
+use crate::pin::PinPoint;
 
 /// Signals the block reads.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -42,16 +43,26 @@ pub struct ReactionInputs {
 pub struct ArmReactions {
     arm: Arc<PlanarArm>,
     inputs: ReactionInputs,
-    acts: Vec<(Option<Station>, Option<Station>, LinearActuator)>,
+    /// Per actuator, its pins (a, b) resolved on the arm.
+    acts: Vec<(PinPoint, PinPoint)>,
     springs: Vec<(Station, f64)>,
     paper: bool,
+    ws: RefCell<Workspace>,
 }
 
-fn station(arm: &PlanarArm, pin: &Pin) -> Result<Option<Station>, ParamError> {
-    match *pin {
-        Pin::Ground(_) => Ok(None),
-        Pin::Link { link, x } => Ok(Some(arm.station(link, x)?)),
-    }
+/// Buffers for one evaluation.
+#[derive(Debug)]
+struct Workspace {
+    frames: Frames,
+    /// q, u, u̇ (n each).
+    q: Vec<f64>,
+    u: Vec<f64>,
+    udot: Vec<f64>,
+    /// The force of each actuator on its pin b (frame 0).
+    act_forces: Vec<Vector2<f64>>,
+    /// ρ, then the paper's variant.
+    rho: Vec<f64>,
+    rho_paper: Vec<f64>,
 }
 
 impl ArmReactions {
@@ -71,21 +82,29 @@ impl ArmReactions {
         }
         let acts = acts
             .iter()
-            .map(|a| Ok((station(&arm, &a.a)?, station(&arm, &a.b)?, *a)))
-            .collect::<Result<_, ParamError>>()?;
+            .map(|a| Ok((arm.resolve_pin(&a.a)?, arm.resolve_pin(&a.b)?)))
+            .collect::<Result<Vec<_>, ParamError>>()?;
         let springs = springs
             .iter()
-            .map(|m| {
-                Ok((
-                    station(&arm, &m.pin)?.ok_or_else(|| ParamError::Shape {
-                        param: "lumped_masses".into(),
-                        message: "a lumped mass must sit on a link".into(),
-                    })?,
-                    m.mass,
-                ))
+            .map(|m| match arm.resolve_pin(&m.pin)? {
+                PinPoint::Station(s) => Ok((s, m.mass)),
+                PinPoint::Ground(_) => Err(ParamError::Shape {
+                    param: "lumped_masses".into(),
+                    message: "a lumped mass must sit on a link".into(),
+                }),
             })
             .collect::<Result<_, ParamError>>()?;
+        let (n, n_rho) = (arm.n(), 2 * arm.n_links());
         Ok(Self {
+            ws: RefCell::new(Workspace {
+                frames: arm.frames(),
+                q: vec![0.0; n],
+                u: vec![0.0; n],
+                udot: vec![0.0; n],
+                act_forces: vec![Vector2::zeros(); acts.len()],
+                rho: vec![0.0; n_rho],
+                rho_paper: vec![0.0; n_rho],
+            }),
             arm,
             inputs,
             acts,
@@ -144,50 +163,60 @@ impl Element for ArmReactions {
         out
     }
     fn eval(&self, _: usize, io: &mut Io<'_>) {
-        let (q, u, udot) = (
-            io.input(0).to_vec(),
-            io.input(1).to_vec(),
-            io.input(2).to_vec(),
-        );
-        let kin = self.arm.kinematics(&q);
+        let mut ws = self.ws.borrow_mut();
+        let Workspace {
+            frames,
+            q,
+            u,
+            udot,
+            act_forces,
+            rho,
+            rho_paper,
+        } = &mut *ws;
+        q.copy_from_slice(io.input(0));
+        u.copy_from_slice(io.input(1));
+        udot.copy_from_slice(io.input(2));
+        let kin = ArmKinematics::new(self.arm.pose_in(q, frames));
         let pose = kin.pose();
-        let mut loads = Vec::new();
-        for (c, (sa, sb, act)) in self.acts.iter().enumerate() {
-            let f = io.u(3 + c) * act.direction(pose);
-            if let Some(s) = sb {
-                loads.push(PointLoad {
-                    station: s.clone(),
-                    force: f,
-                });
-            }
-            if let Some(s) = sa {
-                loads.push(PointLoad {
-                    station: s.clone(),
-                    force: -f,
-                });
+        for (c, (a, b)) in self.acts.iter().enumerate() {
+            let d = pose.pin_point_position(b) - pose.pin_point_position(a);
+            act_forces[c] = io.u(3 + c) * d / d.norm();
+        }
+        // +F e on pin b, −F e on pin a
+        let act_loads = || {
+            self.acts
+                .iter()
+                .zip(act_forces.iter())
+                .flat_map(|((a, b), f)| {
+                    [(b.station(), *f), (a.station(), -f)]
+                        .into_iter()
+                        .filter_map(|(s, f)| s.map(|s| (s, f)))
+                })
+        };
+        let pin_forces = self
+            .inputs
+            .pin_forces
+            .as_ref()
+            .map_or(&[][..], |_| io.input(3 + self.acts.len()));
+        let spring_loads = self
+            .springs
+            .iter()
+            .enumerate()
+            .map(|(k, (s, _))| (s, Vector2::new(pin_forces[2 * k], pin_forces[2 * k + 1])));
+        kin.reactions_into(u, udot, act_loads().chain(spring_loads), &[], rho);
+        if self.paper {
+            if self.springs.is_empty() {
+                rho_paper.copy_from_slice(rho);
+            } else {
+                kin.reactions_into(u, udot, act_loads(), &self.springs, rho_paper);
             }
         }
-        let n_act_loads = loads.len();
-        if self.inputs.pin_forces.is_some() {
-            let pf = io.input(3 + self.acts.len()).to_vec();
-            for (k, (s, _)) in self.springs.iter().enumerate() {
-                loads.push(PointLoad {
-                    station: s.clone(),
-                    force: Vector2::new(pf[2 * k], pf[2 * k + 1]),
-                });
-            }
-        }
-        let rho = kin.reactions(&u, &udot, &loads, &[]);
+        drop(kin);
         for (k, r) in rho.iter().enumerate() {
             io.set_y(k, 0, *r);
         }
         if self.paper {
-            let paper = if self.springs.is_empty() {
-                rho.clone()
-            } else {
-                kin.reactions(&u, &udot, &loads[..n_act_loads], &self.springs)
-            };
-            for (k, r) in paper.iter().enumerate() {
+            for (k, r) in rho_paper.iter().enumerate() {
                 io.set_y(self.n_rho() + k, 0, *r);
             }
         }
