@@ -172,9 +172,6 @@ pub struct Statistics {
     pub steps: usize,
     /// Right-hand-side evaluations requested by the solver.
     pub rhs_evals: usize,
-    /// Right-hand-side evaluations spent in finite-difference Jacobian–vector products
-    /// (none since the Jacobian is assembled exactly: see `jac_assemblies`).
-    pub jac_rhs_evals: usize,
     /// Jacobian evaluations requested by the solver.
     pub jac_evals: usize,
     /// Exact Jacobians assembled by [`StateEquations::jacobian`] (one per new (t, x) at which
@@ -198,10 +195,9 @@ impl std::fmt::Display for Statistics {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "steps {}, rhs evals {} (+{} for Jacobians), Jacobian evals {} ({} assembled), LU factorisations {}, error-test failures {}, Newton iterations {}, Newton failures {}, events {}, wall time {:.3} s",
+            "steps {}, rhs evals {}, Jacobian evals {} ({} assembled), LU factorisations {}, error-test failures {}, Newton iterations {}, Newton failures {}, events {}, wall time {:.3} s",
             self.steps,
             self.rhs_evals,
-            self.jac_rhs_evals,
             self.jac_evals,
             self.jac_assemblies,
             self.lu_factorisations,
