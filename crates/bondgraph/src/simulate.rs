@@ -34,8 +34,7 @@ type LS = NalgebraLU<f64>;
 /// Integration method.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Method {
-    /// Variable-order BDF (NDF), orders 1–5: the default for stiff systems.
-    #[default]
+    /// Variable-order BDF (NDF), orders 1–5.
     Bdf,
     /// Explicit-first-stage singly diagonally implicit Runge–Kutta, order 3 (4 stages).
     Esdirk34,
@@ -43,8 +42,9 @@ pub enum Method {
     TrBdf2,
     /// Tsitouras 5(4), explicit: only for non-stiff models.
     Tsit45,
-    /// Radau IIA, order 5 (3-stage, L-stable): for stiff systems with lightly damped
-    /// oscillations (see [`radau`](crate::radau)).
+    /// Radau IIA, order 5 (3-stage, L-stable): the default, for stiff systems, lightly
+    /// damped oscillations included (see [`radau`](crate::radau)).
+    #[default]
     Radau5,
 }
 
@@ -112,7 +112,7 @@ impl Default for Settings {
             t_start: 0.0,
             t_end: 1.0,
             dt_out: 0.01,
-            method: Method::Bdf,
+            method: Method::Radau5,
             rtol: 1e-6,
             atol: 1e-8,
             max_steps: 10_000_000,

@@ -69,7 +69,7 @@ fn reaches_the_set_point_short_by_the_leakage_offset_and_holds_the_load() {
 }
 
 #[test]
-fn stiff_and_soft_oil_complete_with_bdf() {
+fn stiff_and_soft_oil_complete_with_bdf_and_radau5() {
     // Stiff: β = 1e11 Pa, starting fully retracted with a 0.1 mm piston-side dead length
     // (V_p = 0.79 cm³ at s = 0, hydraulic stiffness 8e12 N/m on 10 t: ω ≈ 2.8e4 rad/s).
     // Soft: β = 1e7 Pa (ω ≈ 5 rad/s; the chamber pressures settle with a time constant of
@@ -92,9 +92,13 @@ fn stiff_and_soft_oil_complete_with_bdf() {
             ],
         ),
     ];
-    for (name, set) in cases {
+    for (method, (name, set)) in [bondgraph::Method::Bdf, bondgraph::Method::Radau5]
+        .into_iter()
+        .flat_map(|m| cases.iter().map(move |c| (m, c)))
+    {
         let mut m = load("cylinder_lift", set).unwrap();
-        assert_eq!(m.settings.method, bondgraph::Method::Bdf);
+        m.settings.method = method;
+        let name = format!("{name}, {}", method.name());
         let out = m.run().unwrap();
         assert!(out.error.is_none(), "{name}: {:?}", out.error);
         let (_, _, _, offset) = steady_state(&m);
