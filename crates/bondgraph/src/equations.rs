@@ -18,6 +18,8 @@ use crate::element::{Element, Io, Layout, PortLayout, Ports, Slot, Source};
 use crate::error::{CausalityError, GraphError};
 use crate::graph::{check_same_shape, BondGraph};
 
+mod jacobian;
+
 /// A named state of the assembled system.
 #[derive(Clone, Debug)]
 pub struct StateInfo {
@@ -75,6 +77,9 @@ pub struct StateEquations {
     n_bond_values: usize,
     signal_names: Vec<(String, usize, usize)>,
     ws: RefCell<Workspace>,
+    jac_plan: jacobian::JacobianPlan,
+    /// The Jacobian's buffers, allocated by its first call.
+    jac_work: RefCell<Option<jacobian::JacobianWork>>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -166,9 +171,12 @@ impl StateEquations {
             n_bond_values,
             signal_names,
             ws: RefCell::new(Workspace::default()),
+            jac_plan: jacobian::JacobianPlan::default(),
+            jac_work: RefCell::new(None),
         };
         eqs.resolve_inputs()?;
         eqs.plan()?;
+        eqs.jac_plan = eqs.jacobian_plan();
         *eqs.ws.borrow_mut() = Workspace {
             effort: vec![0.0; n_bond_values],
             flow: vec![0.0; n_bond_values],
@@ -542,6 +550,15 @@ impl StateEquations {
             })?;
         s.initial = value;
         Ok(())
+    }
+
+    /// Number of signal scalars.
+    fn n_signal_values(&self) -> usize {
+        self.signal_names
+            .iter()
+            .map(|(_, o, d)| o + d)
+            .max()
+            .unwrap_or(0)
     }
 
     /// Evaluation order: (element, stage) pairs.

@@ -54,6 +54,7 @@ pub mod elements;
 pub mod equations;
 pub mod error;
 pub mod graph;
+pub mod local_jacobian;
 pub mod simulate;
 
 pub use bond::{Bond, BondId, ElementId, Endpoint, PortCausality};
@@ -66,6 +67,9 @@ pub use elements::*;
 pub use equations::{Probe, StateEquations, StateInfo};
 pub use error::{CausalityError, Error, GraphError, ParamError, SimulationError};
 pub use graph::{BondGraph, Node};
+pub use local_jacobian::{check_partials, LocalJacobian, LocalShape};
+/// The dense matrix type of [`StateEquations::jacobian`].
+pub use nalgebra::DMatrix;
 pub use simulate::{
     simulate, Event, Method, Outcome, Output, Settings, Statistics, Trajectory, WatchReport,
 };

@@ -27,8 +27,8 @@
 //! solver's tolerance, not cavitation.
 
 use bondgraph::{
-    CausalRule, Element, Io, Param, ParamError, PortCausality, PortSpec, Ports, SignalSpec, Slot,
-    Stage, StateSpec, Watch,
+    CausalRule, Element, Io, LocalJacobian, Param, ParamError, PortCausality, PortSpec, Ports,
+    SignalSpec, Slot, Stage, StateSpec, Watch,
 };
 
 /// Which end of the cylinder a chamber is on: how its volume follows the stroke s.
@@ -132,6 +132,15 @@ impl Chamber {
     pub fn volume(&self, s: f64) -> f64 {
         (self.v0 + self.dv_ds * s).max(self.v_min)
     }
+
+    /// dV/ds at stroke `s`: `dv_ds`, or 0 where the volume is held at `v_min`.
+    fn volume_slope(&self, s: f64) -> f64 {
+        if self.v0 + self.dv_ds * s < self.v_min {
+            0.0
+        } else {
+            self.dv_ds
+        }
+    }
 }
 
 impl Element for Chamber {
@@ -179,6 +188,28 @@ impl Element for Chamber {
         let v = self.volume(self.stroke.value(io, 0));
         dx[0] = self.beta / v * io.f_in(0, 0);
     }
+    fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        if stage == 0 {
+            jac.set(jac.row(Slot::Effort(0), 0), jac.state_col(0), 1.0);
+        } else {
+            let dv_ds = self.volume_slope(self.stroke.value(io, 0));
+            let row = jac.row(Slot::Output(0), 0);
+            self.stroke
+                .partials(io, 0, |i, d| jac.set(row, jac.input_col(i, 0), dv_ds * d));
+        }
+        true
+    }
+    fn derivative_partials(&self, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        // dP/dt = β/V(s)·f_in
+        let s = self.stroke.value(io, 0);
+        let v = self.volume(s);
+        let row = jac.derivative_row(0);
+        jac.set(row, jac.flow_col(0, 0), self.beta / v);
+        let dd_ds = -self.beta * io.f_in(0, 0) / (v * v) * self.volume_slope(s);
+        self.stroke
+            .partials(io, 0, |i, d| jac.set(row, jac.input_col(i, 0), dd_ds * d));
+        true
+    }
     fn watches(&self) -> Vec<Watch> {
         vec![Watch {
             name: "pressure".into(),
@@ -207,6 +238,22 @@ mod tests {
         );
         let f = Chamber::fixed(2e-3, 1.5e9, 0.0).unwrap();
         assert!((f.volume(123.0) - 2e-3).abs() < 1e-18);
+    }
+
+    #[test]
+    fn partials_match_central_differences() {
+        use bondgraph::check_partials;
+        let stroke = || Param::modulated(vec!["s".into()], |_, u| u[0]);
+        let p = Chamber::cylinder(Side::Piston, 0.045, 0.05, 1.5e9, stroke(), 0.0).unwrap();
+        let r = Chamber::cylinder(Side::Rod, 0.042, 2.75, 1.5e9, stroke(), 0.0).unwrap();
+        let port = [(1, 1.0, PortCausality::EffortOut)];
+        // P, Q_in, s, P (state)
+        for c in [&p, &r] {
+            for s in [0.6, -0.3, 2.9] {
+                let point = [0.0, 2e-3, s, 5e6];
+                assert_eq!(check_partials(c, &port, &point), Ok(3), "{s}");
+            }
+        }
     }
 
     #[test]

@@ -18,8 +18,8 @@
 //! the extension rate: on that junction the rod then delivers F_c − e.
 
 use bondgraph::{
-    CausalRule, Element, Io, Param, ParamError, PortCausality, PortSpec, Ports, SignalSpec, Slot,
-    Stage,
+    CausalRule, Element, Io, LocalJacobian, Param, ParamError, PortCausality, PortSpec, Ports,
+    SignalSpec, Slot, Stage,
 };
 
 /// End stop on the stroke range `[s_min, s_max]` (m), stiffness `k` (N/m, > 0), damping `c`
@@ -78,6 +78,31 @@ impl EndStop {
             0.0
         }
     }
+
+    /// The partials of [`force`](Self::force) with respect to s and v: `(∂e/∂s, ∂e/∂v)`.
+    /// Where the clamp holds the force at 0 both are 0.
+    #[must_use]
+    pub fn force_partials(&self, s: f64, v: f64) -> (f64, f64) {
+        let (d, sign) = if s > self.s_max {
+            (s - self.s_max, 1.0)
+        } else if s < self.s_min {
+            (self.s_min - s, -1.0)
+        } else {
+            return (0.0, 0.0);
+        };
+        // e = clamp(sign·k·d + c·min(1, d/δ)·v) with dd/ds = sign
+        let w = (d / self.width).min(1.0);
+        let inner = sign * self.k * d + self.c * w * v;
+        if inner * sign <= 0.0 {
+            return (0.0, 0.0);
+        }
+        let dw_dd = if d < self.width {
+            1.0 / self.width
+        } else {
+            0.0
+        };
+        (self.k + sign * self.c * dw_dd * v, self.c * w)
+    }
 }
 
 impl Element for EndStop {
@@ -105,6 +130,14 @@ impl Element for EndStop {
         let f = self.force(self.stroke.value(io, 0), io.f_in(0, 0));
         io.set_e(0, 0, f);
     }
+    fn stage_partials(&self, _: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        let (de_ds, de_dv) = self.force_partials(self.stroke.value(io, 0), io.f_in(0, 0));
+        let row = jac.row(Slot::Effort(0), 0);
+        jac.set(row, jac.flow_col(0, 0), de_dv);
+        self.stroke
+            .partials(io, 0, |i, d| jac.set(row, jac.input_col(i, 0), de_ds * d));
+        true
+    }
 }
 
 #[cfg(test)]
@@ -126,6 +159,27 @@ mod tests {
         assert_eq!(e.force(-1e-4, 50.0), 0.0);
         // continuous at contact
         assert!(e.force(2.7 + 1e-12, 1.0).abs() < 1e-2);
+    }
+
+    #[test]
+    fn partials_match_central_differences_in_every_regime() {
+        use bondgraph::check_partials;
+        let stroke = Param::modulated(vec!["s".into()], |_, u| u[0]);
+        let e = EndStop::new(stroke, 0.0, 2.7, 1e9, 1e6, 1e-3).unwrap();
+        let port = [(1, -1.0, PortCausality::EffortOut)];
+        // (s, v): inside; past the top in and beyond the contact width; past the bottom;
+        // pulling (clamped)
+        for (s, v) in [
+            (1.0, 0.3),
+            (2.7004, 0.1),
+            (2.705, -0.2),
+            (-4e-4, -0.1),
+            (-3e-3, 0.5),
+            (2.7005, -10.0),
+        ] {
+            // F, v_in, s
+            assert_eq!(check_partials(&e, &port, &[0.0, v, s]), Ok(1), "{s} {v}");
+        }
     }
 
     #[test]

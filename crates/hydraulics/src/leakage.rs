@@ -9,7 +9,9 @@
 //! (ΔP)²/R ≥ 0. Causality: conductance (the lines set the pressures, the leak its flow); the
 //! external leak also accepts resistance causality (P = P_T + R·Q).
 
-use bondgraph::{CausalRule, Element, Io, ParamError, PortCausality, PortSpec, Ports};
+use bondgraph::{
+    CausalRule, Element, Io, LocalJacobian, ParamError, PortCausality, PortSpec, Ports, Slot,
+};
 
 /// Laminar leakage with resistance `r` (Pa·s/m³, > 0): internal (two ports) or to a tank at
 /// pressure `p_tank` (one port).
@@ -71,11 +73,43 @@ impl Element for Leakage {
             },
         }
     }
+    fn stage_partials(&self, _: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        let g = 1.0 / self.r;
+        match (self.tank, io.causality(0)) {
+            (None, _) => {
+                for (p, s) in [(0, 1.0), (1, -1.0)] {
+                    let row = jac.row(Slot::Flow(p), 0);
+                    jac.set(row, jac.effort_col(0, 0), s * g);
+                    jac.set(row, jac.effort_col(1, 0), -s * g);
+                }
+            }
+            (Some(_), PortCausality::FlowOut) => {
+                jac.set(jac.row(Slot::Flow(0), 0), jac.effort_col(0, 0), g);
+            }
+            (Some(_), PortCausality::EffortOut) => {
+                jac.set(jac.row(Slot::Effort(0), 0), jac.flow_col(0, 0), self.r);
+            }
+        }
+        true
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn partials_match_central_differences() {
+        use bondgraph::check_partials;
+        use PortCausality::{EffortOut, FlowOut};
+        let i = Leakage::internal(1e13).unwrap();
+        let ports = [(1, 1.0, FlowOut), (1, -1.0, FlowOut)];
+        assert_eq!(check_partials(&i, &ports, &[11e6, 1e-6, 1e6, 1e-6]), Ok(1));
+        let t = Leakage::to_tank(1e12, 1e5).unwrap();
+        for c in [FlowOut, EffortOut] {
+            assert_eq!(check_partials(&t, &[(1, 1.0, c)], &[3e6, 2e-6]), Ok(1));
+        }
+    }
 
     #[test]
     fn rejects_non_positive_resistance() {

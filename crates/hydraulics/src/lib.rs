@@ -61,7 +61,7 @@ pub use cylinder::{
 };
 pub use end_stop::EndStop;
 pub use leakage::Leakage;
-pub use orifice::{alpha, reg_root, Orifice};
+pub use orifice::{alpha, reg_root, reg_root_derivative, Orifice};
 pub use piston::Piston;
 pub use valve::Valve;
 

@@ -17,8 +17,8 @@
 //! dissipated (≥ 0 for x ≥ 0).
 
 use bondgraph::{
-    CausalRule, Element, Io, Param, ParamError, PortCausality, PortSpec, Ports, SignalSpec, Slot,
-    Stage,
+    CausalRule, Element, Io, LocalJacobian, Param, ParamError, PortCausality, PortSpec, Ports,
+    SignalSpec, Slot, Stage,
 };
 
 /// The regularised square root `Δp / (Δp² + p_tr²)^(1/4)`; `sign(Δp)·√|Δp|` when `p_tr = 0`.
@@ -28,6 +28,17 @@ pub fn reg_root(dp: f64, p_tr: f64) -> f64 {
         return dp.signum() * dp.abs().sqrt();
     }
     dp / (dp * dp + p_tr * p_tr).sqrt().sqrt()
+}
+
+/// The slope of [`reg_root`]: `(Δp²/2 + p_tr²)/(Δp² + p_tr²)^(5/4)`, which is `1/√p_tr` at
+/// Δp = 0; `1/(2√|Δp|)` (infinite at 0) when `p_tr = 0`.
+#[must_use]
+pub fn reg_root_derivative(dp: f64, p_tr: f64) -> f64 {
+    if p_tr == 0.0 {
+        return 0.5 / dp.abs().sqrt();
+    }
+    let s = dp * dp + p_tr * p_tr;
+    (0.5 * dp * dp + p_tr * p_tr) / (s * s.sqrt().sqrt())
 }
 
 /// Orifice coefficient `α = C_d·w·√(2/ρ)` (eq. 31): discharge coefficient `cd`, opening area
@@ -100,6 +111,22 @@ impl Element for Orifice {
         io.set_f_in(0, 0, q);
         io.set_f_in(1, 0, -q);
     }
+    fn stage_partials(&self, _: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        let x = self.opening.value(io, 0);
+        let dp = io.e(0, 0) - io.e(1, 0);
+        // q = α·x·regRoot(Δp): ∂q/∂P_a = −∂q/∂P_b = α·x·regRoot′(Δp)
+        let dq_dp = self.alpha * x * reg_root_derivative(dp, self.p_tr);
+        let dq_dx = self.alpha * reg_root(dp, self.p_tr);
+        for (p, s) in [(0, 1.0), (1, -1.0)] {
+            let row = jac.row(Slot::Flow(p), 0);
+            jac.set(row, jac.effort_col(0, 0), s * dq_dp);
+            jac.set(row, jac.effort_col(1, 0), -s * dq_dp);
+            self.opening.partials(io, 0, |i, d| {
+                jac.set(row, jac.input_col(i, 0), s * dq_dx * d)
+            });
+        }
+        true
+    }
 }
 
 #[cfg(test)]
@@ -148,6 +175,37 @@ mod tests {
         assert!((d(1e-2) - d(-1e-2)).abs() <= 1e-9 * slope);
         // whereas the paper's law has no finite slope there
         assert!((paper(1e-6) - paper(0.0)) / 1e-6 > 900.0);
+    }
+
+    #[test]
+    fn reg_root_derivative_is_exact() {
+        for p_tr in [0.0, 1e5] {
+            for dp in [-3e7_f64, -2e5, -1e3, 1e-2, 5e4, 1e5, 2.5e7] {
+                let h = 1e-5 * dp.abs();
+                let fd = (reg_root(dp + h, p_tr) - reg_root(dp - h, p_tr)) / (2.0 * h);
+                let d = reg_root_derivative(dp, p_tr);
+                assert!(
+                    (d - fd).abs() <= 1e-8 * d.abs(),
+                    "{p_tr} {dp}: {d:e} {fd:e}"
+                );
+            }
+        }
+        assert!((reg_root_derivative(0.0, 1e4) - 1e-2).abs() < 1e-15);
+    }
+
+    #[test]
+    fn partials_match_central_differences() {
+        use bondgraph::check_partials;
+        let o = Orifice::new(2e-6, Param::modulated(vec!["x".into()], |_, u| u[0]), 1e5).unwrap();
+        let ports = [
+            (1, 1.0, PortCausality::FlowOut),
+            (1, -1.0, PortCausality::FlowOut),
+        ];
+        // P_a, Q_a, P_b, Q_b, x
+        for (pa, pb) in [(4e6, 1e6), (1e6, 1.02e6), (2e5, 9e6)] {
+            let point = [pa, 1e-3, pb, 1e-3, 0.6];
+            assert_eq!(check_partials(&o, &ports, &point), Ok(1), "{pa} {pb}");
+        }
     }
 
     #[test]

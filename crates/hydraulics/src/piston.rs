@@ -24,8 +24,8 @@
 //! (`guard = false`) the piston goes on past the ends and the stop pushes it back.
 
 use bondgraph::{
-    CausalRule, Element, Io, Limit, ParamError, PortCausality, PortSpec, Ports, SignalSpec, Slot,
-    Stage, StateSpec,
+    CausalRule, Element, Io, Limit, LocalJacobian, ParamError, PortCausality, PortSpec, Ports,
+    SignalSpec, Slot, Stage, StateSpec,
 };
 
 /// Piston with areas `a_p` (piston side) and `a_r` (rod side, annulus), m², and its stroke.
@@ -142,6 +142,27 @@ impl Element for Piston {
     fn derivatives(&self, io: &Io<'_>, dx: &mut [f64]) {
         dx[0] = Self::v(io);
     }
+    fn stage_partials(&self, stage: usize, _: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        match stage {
+            0 => jac.set(jac.row(Slot::Output(0), 0), jac.state_col(0), 1.0),
+            1 => {
+                let row = jac.row(Slot::Effort(2), 0);
+                jac.set(row, jac.effort_col(0, 0), self.a_p);
+                jac.set(row, jac.effort_col(1, 0), -self.a_r);
+            }
+            _ => {
+                // v = −f_in,mech
+                let col = jac.flow_col(2, 0);
+                jac.set(jac.row(Slot::Flow(0), 0), col, -self.a_p);
+                jac.set(jac.row(Slot::Flow(1), 0), col, self.a_r);
+            }
+        }
+        true
+    }
+    fn derivative_partials(&self, _: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        jac.set(jac.derivative_row(0), jac.flow_col(2, 0), -1.0);
+        true
+    }
     fn limits(&self) -> Vec<Limit> {
         if !self.guard {
             return Vec::new();
@@ -178,6 +199,17 @@ mod tests {
         assert!(l[0].message.contains("end stop"));
         let q = Piston::new(0.04, 0.03, 3.5, 0.0, 2.7, false).unwrap();
         assert!(q.limits().is_empty());
+    }
+
+    #[test]
+    fn partials_match_central_differences() {
+        use bondgraph::check_partials;
+        use PortCausality::{EffortOut, FlowOut};
+        let p = Piston::new(0.045, 0.042, 3.5, 0.1, 2.7, true).unwrap();
+        let ports = [(1, 1.0, FlowOut), (1, -1.0, FlowOut), (1, -1.0, EffortOut)];
+        // P_p, Q_p, P_r, Q_r, F, v_in, s
+        let point = [11e6, 1e-3, 1e6, -1e-3, 4e5, -0.05, 1.2];
+        assert_eq!(check_partials(&p, &ports, &point), Ok(4));
     }
 
     #[test]

@@ -18,11 +18,11 @@
 //! lines: the bond flow is then Q_A (Q_B).
 
 use bondgraph::{
-    CausalRule, Element, Io, Param, ParamError, PortCausality, PortSpec, Ports, SignalSpec, Slot,
-    Stage,
+    CausalRule, Element, Io, LocalJacobian, Param, ParamError, PortCausality, PortSpec, Ports,
+    SignalSpec, Slot, Stage,
 };
 
-use crate::orifice::reg_root;
+use crate::orifice::{reg_root, reg_root_derivative};
 
 /// 4/3 proportional directional valve.
 ///
@@ -83,6 +83,35 @@ impl Valve {
             (r(p_a - self.p_t), -r(self.p_s - p_b))
         }
     }
+
+    /// The partials of the flow into line `line` (0: A, 1: B) with respect to its pressure
+    /// and to the spool stroke x_v: `(∂Q/∂P, ∂Q/∂x_v)`. The clamp has slope 0 outside
+    /// [−1, 1]; at x_v = 0 the derivatives are those of the x_v ≥ 0 side, which `flows`
+    /// evaluates there.
+    #[must_use]
+    pub fn flow_partials(&self, line: usize, x_v: f64, p: f64) -> (f64, f64) {
+        let x = x_v.clamp(-1.0, 1.0);
+        let dx = if (-1.0..=1.0).contains(&x_v) {
+            1.0
+        } else {
+            0.0
+        };
+        let (rr, drr) = (
+            |d: f64| reg_root(d, self.p_tr),
+            |d: f64| reg_root_derivative(d, self.p_tr),
+        );
+        let a = self.alpha;
+        match (line, x >= 0.0) {
+            // Q_A = α·x·rr(P_s − P_A)
+            (0, true) => (-a * x * drr(self.p_s - p), a * rr(self.p_s - p) * dx),
+            // Q_A = α·x·rr(P_A − P_T)
+            (0, false) => (a * x * drr(p - self.p_t), a * rr(p - self.p_t) * dx),
+            // Q_B = −α·x·rr(P_B − P_T)
+            (_, true) => (-a * x * drr(p - self.p_t), -a * rr(p - self.p_t) * dx),
+            // Q_B = −α·x·rr(P_s − P_B)
+            (_, false) => (a * x * drr(self.p_s - p), -a * rr(self.p_s - p) * dx),
+        }
+    }
 }
 
 impl Element for Valve {
@@ -121,6 +150,17 @@ impl Element for Valve {
         } else {
             io.set_f_in(1, 0, -q_b);
         }
+    }
+    fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        let x = self.x_v.value(io, 0);
+        let line = stage.min(1);
+        let (dq_dp, dq_dx) = self.flow_partials(line, x, io.e(line, 0));
+        // f_in = −Q
+        let row = jac.row(Slot::Flow(line), 0);
+        jac.set(row, jac.effort_col(line, 0), -dq_dp);
+        self.x_v
+            .partials(io, 0, |i, d| jac.set(row, jac.input_col(i, 0), -dq_dx * d));
+        true
     }
 }
 
@@ -189,6 +229,28 @@ mod tests {
                 (left - slope).abs() <= 1e-6 * slope.abs(),
                 "{left:e} vs {slope:e}"
             );
+        }
+    }
+
+    #[test]
+    fn partials_match_central_differences_on_both_sides_and_clamped() {
+        use bondgraph::check_partials;
+        let x_v = Param::modulated(vec!["spool".into()], |_, u| 2.0 * u[0]);
+        let v = Valve::new(1e-6, x_v, 25e6, 0.0, 1e5).unwrap();
+        let ports = [
+            (1, -1.0, PortCausality::FlowOut),
+            (1, -1.0, PortCausality::FlowOut),
+        ];
+        for spool in [0.2, -0.3, 0.8, -0.9] {
+            for (pa, pb) in [(11e6, 1e6), (3e4, 24.99e6), (25.02e6, -2e4)] {
+                // P_A, Q_A, P_B, Q_B, spool
+                let point = [pa, 1e-3, pb, 1e-3, spool];
+                assert_eq!(
+                    check_partials(&v, &ports, &point),
+                    Ok(2),
+                    "{spool} {pa} {pb}"
+                );
+            }
         }
     }
 

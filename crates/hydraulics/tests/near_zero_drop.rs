@@ -3,9 +3,10 @@
 //!
 //! 1. A chamber drains through an open orifice to tank (in 0.042 s) and then sits at Δp ≈ 0
 //!    until t = 100 s. With regRoot (p_tr = 1e5 Pa) this takes under 200 steps. The paper's
-//!    law (p_tr = 0), whose slope is infinite at Δp = 0, needs tens of thousands of steps for
-//!    every few milliseconds spent there (measured: 1.3 million steps to reach t = 0.1 s):
-//!    it is run to t = 0.05 s only, to show the contrast.
+//!    law (p_tr = 0) has an infinite slope at Δp = 0: with the finite-difference Jacobian the
+//!    solver chattered there (1.3 million steps to reach t = 0.1 s), because a difference step
+//!    across Δp = 0 misjudges the slope by orders of magnitude. With the exact Jacobian
+//!    (`StateEquations::jacobian`) it reaches t = 100 s in under 200 steps too.
 //! 2. A cylinder with no load, both chambers at tank pressure, is nudged 10 µm off its
 //!    set-point; the P-controlled valve creeps it back and then sits closed, with the rod
 //!    side at a few kPa (Δp across the tank-side orifice ≪ p_tr), until t = 100 s.
@@ -96,18 +97,20 @@ fn draining_to_tank_and_sitting_there_does_not_stall() {
         p.last().unwrap()
     );
     assert!(run.stats.steps < 500, "{} steps", run.stats.steps);
-    // the paper's law, only to t = 0.05 s (0.008 s after the chamber has drained)
-    let paper = drain(0.0, 0.05);
+    // the paper's law: the exact Jacobian keeps Newton converging at the infinite slope
+    let paper = drain(0.0, 100.0);
     eprintln!(
-        "drain to t = 0.05 s, p_tr = 0 (the paper's law): {}",
+        "drain to t = 100 s, p_tr = 0 (the paper's law): {}",
         paper.stats
     );
+    assert!(paper.error.is_none(), "{:?}", paper.error);
+    let p = paper.trajectory.column("p").unwrap();
     assert!(
-        paper.stats.steps > 100 * run.stats.steps,
-        "the regularisation should matter: {} vs {} steps",
-        paper.stats.steps,
-        run.stats.steps
+        p.last().unwrap().abs() < 1.0,
+        "still {} Pa",
+        p.last().unwrap()
     );
+    assert!(paper.stats.steps < 500, "{} steps", paper.stats.steps);
 }
 
 #[test]

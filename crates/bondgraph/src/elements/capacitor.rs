@@ -8,10 +8,11 @@
 
 use crate::bond::PortCausality;
 use crate::element::{
-    CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Stage, StateSpec,
+    CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Slot, Stage, StateSpec,
 };
 use crate::elements::component_names;
 use crate::error::ParamError;
+use crate::local_jacobian::LocalJacobian;
 
 /// Capacitor (spring, compliance). Compliance `c` in flow·time/effort (F, m/N, m³/Pa).
 #[derive(Debug)]
@@ -79,6 +80,24 @@ impl Element for Capacitor {
             *d = io.f_in(0, k);
         }
     }
+    fn stage_partials(&self, _: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        // e = q/c(u)
+        let c = self.c.value(io, 0);
+        for k in 0..self.q0.len() {
+            let row = jac.row(Slot::Effort(0), k);
+            jac.set(row, jac.state_col(k), 1.0 / c);
+            let de_dc = -io.states()[k] / (c * c);
+            self.c
+                .partials(io, 0, |i, d| jac.set(row, jac.input_col(i, 0), de_dc * d));
+        }
+        true
+    }
+    fn derivative_partials(&self, _: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        for k in 0..self.q0.len() {
+            jac.set(jac.derivative_row(k), jac.flow_col(0, k), 1.0);
+        }
+        true
+    }
     fn stored_energy(&self, x: &[f64]) -> Option<f64> {
         let c = self.c.constant()?;
         Some(x.iter().map(|q| q * q / (2.0 * c)).sum())
@@ -88,6 +107,20 @@ impl Element for Capacitor {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::check_partials;
+
+    #[test]
+    fn partials_match_central_differences() {
+        let c = Capacitor::multi(
+            Param::modulated(vec!["u".into()], |_, u| 0.5 + u[0]),
+            vec![0.0; 2],
+        )
+        .unwrap();
+        let port = [(2, -1.0, PortCausality::EffortOut)];
+        // e[2], f_in[2], u, q[2]
+        let point = [0.0, 0.0, 0.3, -0.2, 0.25, 1.2, -0.8];
+        assert_eq!(check_partials(&c, &port, &point), Ok(2));
+    }
 
     #[test]
     fn rejects_non_positive_compliance() {

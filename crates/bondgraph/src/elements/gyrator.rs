@@ -8,6 +8,7 @@
 use crate::bond::PortCausality;
 use crate::element::{CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Slot, Stage};
 use crate::error::ParamError;
+use crate::local_jacobian::LocalJacobian;
 
 /// Gyrator with (possibly modulated) modulus `r` (units e₁/f₂, e.g. N·m/A).
 #[derive(Debug)]
@@ -74,11 +75,62 @@ impl Element for Gyrator {
             }
         }
     }
+    fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        let r = self.r.value(io, 0);
+        let impedance = io.causality(0) == PortCausality::EffortOut;
+        for k in 0..io.dim(0) {
+            // (row, column, ∂row/∂column, ∂row/∂r)
+            let (row, col, v, dr) = match (stage, impedance) {
+                (0, true) => (
+                    jac.row(Slot::Effort(0), k),
+                    jac.flow_col(1, k),
+                    -r,
+                    -io.f_in(1, k),
+                ),
+                (1, true) => (
+                    jac.row(Slot::Effort(1), k),
+                    jac.flow_col(0, k),
+                    r,
+                    io.f_in(0, k),
+                ),
+                (0, false) => (
+                    jac.row(Slot::Flow(1), k),
+                    jac.effort_col(0, k),
+                    -1.0 / r,
+                    io.e(0, k) / (r * r),
+                ),
+                _ => (
+                    jac.row(Slot::Flow(0), k),
+                    jac.effort_col(1, k),
+                    1.0 / r,
+                    -io.e(1, k) / (r * r),
+                ),
+            };
+            jac.set(row, col, v);
+            self.r
+                .partials(io, 0, |i, d| jac.set(row, jac.input_col(i, 0), dr * d));
+        }
+        true
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::check_partials;
+
+    #[test]
+    fn partials_match_central_differences_in_both_causalities() {
+        use PortCausality::{EffortOut as E, FlowOut as F};
+        let gy =
+            Gyrator::new(Param::modulated(vec!["u".into()], |_, u| 0.5 + u[0] * u[0])).unwrap();
+        // e1, f1, e2, f2, u
+        let point = [2.0, -0.5, 1.1, 0.8, 0.3];
+        for c in [E, F] {
+            let ports = [(1, 1.0, c), (1, -1.0, c)];
+            assert_eq!(check_partials(&gy, &ports, &point), Ok(2));
+        }
+    }
 
     #[test]
     fn rejects_zero_modulus() {

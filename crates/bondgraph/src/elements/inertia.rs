@@ -7,10 +7,11 @@
 
 use crate::bond::PortCausality;
 use crate::element::{
-    CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Stage, StateSpec,
+    CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Slot, Stage, StateSpec,
 };
 use crate::elements::component_names;
 use crate::error::ParamError;
+use crate::local_jacobian::LocalJacobian;
 
 /// Inertia (mass, inductance). Inertance `m` in effort·time/flow (kg, H, kg/m⁴).
 #[derive(Debug)]
@@ -101,6 +102,24 @@ impl Element for Inertia {
             *d = io.e(0, k);
         }
     }
+    fn stage_partials(&self, _: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        // f_in = p/(m(u)·w)
+        let m = self.m.value(io, 0);
+        for (k, w) in self.weights.iter().enumerate() {
+            let row = jac.row(Slot::Flow(0), k);
+            jac.set(row, jac.state_col(k), 1.0 / (m * w));
+            let df_dm = -io.states()[k] / (m * m * w);
+            self.m
+                .partials(io, 0, |i, d| jac.set(row, jac.input_col(i, 0), df_dm * d));
+        }
+        true
+    }
+    fn derivative_partials(&self, _: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        for k in 0..self.p0.len() {
+            jac.set(jac.derivative_row(k), jac.effort_col(0, k), 1.0);
+        }
+        true
+    }
     fn stored_energy(&self, x: &[f64]) -> Option<f64> {
         let m = self.m.constant()?;
         Some(
@@ -115,6 +134,20 @@ impl Element for Inertia {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::check_partials;
+
+    #[test]
+    fn partials_match_central_differences() {
+        let port = [(2, 1.0, PortCausality::FlowOut)];
+        let i = Inertia::diagonal(vec![2.0, 5.0], vec![0.0; 2]).unwrap();
+        // e[2], f_in[2], p[2]
+        let point = [0.4, -1.0, 0.0, 0.0, 3.0, -2.0];
+        assert_eq!(check_partials(&i, &port, &point), Ok(2));
+        let law = Param::modulated(vec!["u".into()], |_, u| 1.0 + u[0].exp());
+        let i = Inertia::multi(law, vec![0.0; 2]).unwrap();
+        let point = [0.4, -1.0, 0.0, 0.0, 0.3, 3.0, -2.0];
+        assert_eq!(check_partials(&i, &port, &point), Ok(2));
+    }
 
     #[test]
     fn rejects_non_positive_mass() {

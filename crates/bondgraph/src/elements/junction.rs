@@ -8,6 +8,7 @@
 
 use crate::bond::PortCausality;
 use crate::element::{CausalRule, Element, Io, Ports, Slot, Stage};
+use crate::local_jacobian::LocalJacobian;
 
 fn dominant(io: &Io<'_>, c: PortCausality) -> usize {
     (0..io.n_ports())
@@ -69,6 +70,19 @@ impl Element for ZeroJunction {
             }
         }
     }
+    fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        let d = dominant(io, PortCausality::FlowOut);
+        for k in 0..io.dim(d) {
+            for p in (0..io.n_ports()).filter(|&p| p != d) {
+                if stage == 0 {
+                    jac.set(jac.row(Slot::Effort(p), k), jac.effort_col(d, k), 1.0);
+                } else {
+                    jac.set(jac.row(Slot::Flow(d), k), jac.flow_col(p, k), -1.0);
+                }
+            }
+        }
+        true
+    }
 }
 
 /// 1-junction (common flow, series connection, Kirchhoff's voltage law / force balance).
@@ -111,6 +125,45 @@ impl Element for OneJunction {
                 let s = io.sign(d);
                 io.set_e(d, k, -s * sum);
             }
+        }
+    }
+    fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        let d = dominant(io, PortCausality::EffortOut);
+        let sd = io.sign(d);
+        for k in 0..io.dim(d) {
+            for p in (0..io.n_ports()).filter(|&p| p != d) {
+                let sp = io.sign(p);
+                if stage == 0 {
+                    jac.set(jac.row(Slot::Flow(p), k), jac.flow_col(d, k), sp * sd);
+                } else {
+                    jac.set(jac.row(Slot::Effort(d), k), jac.effort_col(p, k), -sd * sp);
+                }
+            }
+        }
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::check_partials;
+
+    #[test]
+    fn partials_match_central_differences() {
+        use PortCausality::{EffortOut as E, FlowOut as F};
+        // three 2-bonds, mixed half-arrows: e, f per port (2 each)
+        let point: Vec<f64> = (0..12).map(|k| 0.3 * k as f64 - 1.1).collect();
+        let signs = [1.0, -1.0, 1.0];
+        for d in 0..3 {
+            let zero: Vec<_> = (0..3)
+                .map(|p| (2, signs[p], if p == d { F } else { E }))
+                .collect();
+            assert_eq!(check_partials(&ZeroJunction, &zero, &point), Ok(2));
+            let one: Vec<_> = (0..3)
+                .map(|p| (2, signs[p], if p == d { E } else { F }))
+                .collect();
+            assert_eq!(check_partials(&OneJunction, &one, &point), Ok(2));
         }
     }
 }

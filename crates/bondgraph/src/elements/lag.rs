@@ -4,8 +4,9 @@
 //! readers never wait for the input). Energy-free bookkeeping, not a storage element.
 
 use crate::bond::PortCausality;
-use crate::element::{CausalRule, Element, Io, Ports, SignalSpec, Stage, StateSpec};
+use crate::element::{CausalRule, Element, Io, Ports, SignalSpec, Slot, Stage, StateSpec};
 use crate::error::ParamError;
+use crate::local_jacobian::LocalJacobian;
 
 /// First-order lag with time constant `tau` (s, > 0) reading the signal `input`.
 #[derive(Debug)]
@@ -57,11 +58,29 @@ impl Element for Lag {
     fn derivatives(&self, io: &Io<'_>, dx: &mut [f64]) {
         dx[0] = (io.u(0) - io.states()[0]) / self.tau;
     }
+    fn stage_partials(&self, _: usize, _: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        jac.set(jac.row(Slot::Output(0), 0), jac.state_col(0), 1.0);
+        true
+    }
+    fn derivative_partials(&self, _: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        let row = jac.derivative_row(0);
+        jac.set(row, jac.input_col(0, 0), 1.0 / self.tau);
+        jac.set(row, jac.state_col(0), -1.0 / self.tau);
+        true
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::check_partials;
+
+    #[test]
+    fn partials_match_central_differences() {
+        let lag = Lag::new("u", 0.1, 0.0).unwrap();
+        // u, y
+        assert_eq!(check_partials(&lag, &[], &[0.7, -0.2]), Ok(2));
+    }
 
     #[test]
     fn rejects_non_positive_time_constant() {

@@ -33,7 +33,9 @@ pub use gyrator::Gyrator;
 pub use inertia::Inertia;
 pub use junction::{OneJunction, ZeroJunction};
 pub use lag::Lag;
-pub use matrix_transformer::{apply_effort, apply_flow, MatrixTransformer};
+pub use matrix_transformer::{
+    apply_effort, apply_flow, effort_partials, flow_partials, MatrixTransformer, ModulusLaw,
+};
 pub use p_controller::PController;
 pub use resistor::Resistor;
 pub use signal_function::SignalFunction;

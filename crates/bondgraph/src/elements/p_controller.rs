@@ -3,8 +3,9 @@
 //! The paper's eq. 83 is `x_v = clamp(−K_v·(l − l_d), −1, 1)`: gain K_v, set-point r = l_d,
 //! measured signal u = l. A stateless signal block (one stage).
 
-use crate::element::{CausalRule, Element, Io, Param, Ports, SignalSpec};
+use crate::element::{CausalRule, Element, Io, Param, Ports, SignalSpec, Slot};
 use crate::error::ParamError;
+use crate::local_jacobian::LocalJacobian;
 
 /// P-controller with gain `gain`, set-point `setpoint` (may be modulated) and output limits.
 #[derive(Debug)]
@@ -69,11 +70,35 @@ impl Element for PController {
         let y = (self.gain * (r - io.u(0))).clamp(self.lo, self.hi);
         io.set_y(0, 0, y);
     }
+    fn stage_partials(&self, _: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        let v = self.gain * (self.setpoint.value(io, 1) - io.u(0));
+        // Saturated: constant. On a limit itself the value is K·(r − u): its slope.
+        if v < self.lo || v > self.hi {
+            return true;
+        }
+        let row = jac.row(Slot::Output(0), 0);
+        jac.set(row, jac.input_col(0, 0), -self.gain);
+        self.setpoint.partials(io, 1, |i, d| {
+            jac.set(row, jac.input_col(1 + i, 0), self.gain * d)
+        });
+        true
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::check_partials;
+
+    #[test]
+    fn partials_match_central_differences_inside_and_saturated() {
+        let sp = Param::modulated(vec!["r".into()], |_, u| 2.0 * u[0]);
+        let c = PController::new("l", 0.3, sp, -1.0, 1.0).unwrap();
+        // l, r
+        for point in [[3.6, 3.0], [9.0, 0.0], [0.0, 9.0]] {
+            assert_eq!(check_partials(&c, &[], &point), Ok(1));
+        }
+    }
 
     #[test]
     fn rejects_bad_limits() {

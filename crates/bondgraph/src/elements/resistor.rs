@@ -5,8 +5,9 @@
 //! non-zero). On a multibond the law applies component-wise.
 
 use crate::bond::PortCausality;
-use crate::element::{CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec};
+use crate::element::{CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Slot};
 use crate::error::ParamError;
+use crate::local_jacobian::LocalJacobian;
 
 /// Linear (or modulated) resistor. Resistance `r` in effort/flow units (Ω, N·s/m, Pa·s/m³).
 #[derive(Debug)]
@@ -52,11 +53,58 @@ impl Element for Resistor {
             }
         }
     }
+    fn stage_partials(&self, _: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        let r = self.r.value(io, 0);
+        for k in 0..io.dim(0) {
+            // e = r·f_in, or f_in = e/r; the modulation enters through r.
+            let (row, col, v, dv_dr) = match io.causality(0) {
+                PortCausality::EffortOut => {
+                    let f = io.f_in(0, k);
+                    (jac.row(Slot::Effort(0), k), jac.flow_col(0, k), r, f)
+                }
+                PortCausality::FlowOut => {
+                    let e = io.e(0, k);
+                    (
+                        jac.row(Slot::Flow(0), k),
+                        jac.effort_col(0, k),
+                        1.0 / r,
+                        -e / (r * r),
+                    )
+                }
+            };
+            jac.set(row, col, v);
+            self.r
+                .partials(io, 0, |i, d| jac.set(row, jac.input_col(i, 0), dv_dr * d));
+        }
+        true
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::check_partials;
+
+    #[test]
+    fn partials_match_central_differences_in_both_causalities() {
+        let r =
+            Resistor::new(Param::modulated(vec!["u".into()], |_, u| 2.0 + u[0] * u[0])).unwrap();
+        for c in [PortCausality::EffortOut, PortCausality::FlowOut] {
+            for sign in [1.0, -1.0] {
+                // e, f_in, u
+                assert_eq!(
+                    check_partials(&r, &[(1, sign, c)], &[3.0, -0.7, 0.4]),
+                    Ok(1)
+                );
+            }
+        }
+        let r2 = Resistor::new(5.0).unwrap();
+        let c = PortCausality::EffortOut;
+        assert_eq!(
+            check_partials(&r2, &[(2, 1.0, c)], &[0.0, 0.0, 1.5, -2.0]),
+            Ok(1)
+        );
+    }
 
     #[test]
     fn rejects_negative_and_nan() {

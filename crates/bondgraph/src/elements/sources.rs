@@ -5,7 +5,8 @@
 //! has `e·f_in < 0`; draw its bond pointing away from it.
 
 use crate::bond::PortCausality as Pc;
-use crate::element::{CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Stage};
+use crate::element::{CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Slot, Stage};
+use crate::local_jacobian::LocalJacobian;
 
 /// Effort source `Se`: e = e_s(t, signals) on every component.
 #[derive(Debug)]
@@ -44,6 +45,14 @@ impl Element for EffortSource {
         for k in 0..io.dim(0) {
             io.set_e(0, k, v);
         }
+    }
+    fn stage_partials(&self, _: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        for k in 0..io.dim(0) {
+            let row = jac.row(Slot::Effort(0), k);
+            self.value
+                .partials(io, 0, |i, d| jac.set(row, jac.input_col(i, 0), d));
+        }
+        true
     }
 }
 
@@ -86,5 +95,44 @@ impl Element for FlowSource {
         for k in 0..io.dim(0) {
             io.set_f_in(0, k, -v);
         }
+    }
+    fn stage_partials(&self, _: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        for k in 0..io.dim(0) {
+            let row = jac.row(Slot::Flow(0), k);
+            self.value
+                .partials(io, 0, |i, d| jac.set(row, jac.input_col(i, 0), -d));
+        }
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::check_partials;
+
+    #[test]
+    fn partials_match_central_differences() {
+        let law = || Param::modulated(vec!["a".into(), "b".into()], |t, u| u[0] * u[1].sin() + t);
+        let se = EffortSource::new(law());
+        let sf = FlowSource::new(law());
+        // e, f_in, a, b
+        let point = [0.0, 0.0, 1.5, 0.7];
+        assert_eq!(
+            check_partials(&se, &[(1, -1.0, Pc::EffortOut)], &point),
+            Ok(1)
+        );
+        assert_eq!(
+            check_partials(&sf, &[(1, -1.0, Pc::FlowOut)], &point),
+            Ok(1)
+        );
+        assert_eq!(
+            check_partials(
+                &EffortSource::new(3.0),
+                &[(1, 1.0, Pc::EffortOut)],
+                &[0.0, 0.0]
+            ),
+            Ok(1)
+        );
     }
 }

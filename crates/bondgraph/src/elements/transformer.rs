@@ -8,6 +8,7 @@
 use crate::bond::PortCausality;
 use crate::element::{CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Slot, Stage};
 use crate::error::ParamError;
+use crate::local_jacobian::LocalJacobian;
 
 /// Transformer with (possibly modulated) modulus `m` (dimensionless or with units e₁/e₂).
 #[derive(Debug)]
@@ -77,11 +78,62 @@ impl Element for Transformer {
             }
         }
     }
+    fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        let m = self.m.value(io, 0);
+        let forward = io.causality(0) == PortCausality::EffortOut;
+        for k in 0..io.dim(0) {
+            // (row, column, ∂row/∂column, ∂row/∂m)
+            let (row, col, v, dm) = match (stage, forward) {
+                (0, true) => (
+                    jac.row(Slot::Effort(0), k),
+                    jac.effort_col(1, k),
+                    m,
+                    io.e(1, k),
+                ),
+                (1, true) => (
+                    jac.row(Slot::Flow(1), k),
+                    jac.flow_col(0, k),
+                    -m,
+                    -io.f_in(0, k),
+                ),
+                (0, false) => (
+                    jac.row(Slot::Effort(1), k),
+                    jac.effort_col(0, k),
+                    1.0 / m,
+                    -io.e(0, k) / (m * m),
+                ),
+                _ => (
+                    jac.row(Slot::Flow(0), k),
+                    jac.flow_col(1, k),
+                    -1.0 / m,
+                    io.f_in(1, k) / (m * m),
+                ),
+            };
+            jac.set(row, col, v);
+            self.m
+                .partials(io, 0, |i, d| jac.set(row, jac.input_col(i, 0), dm * d));
+        }
+        true
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::check_partials;
+
+    #[test]
+    fn partials_match_central_differences_in_both_orientations() {
+        use PortCausality::{EffortOut as E, FlowOut as F};
+        let tf =
+            Transformer::new(Param::modulated(vec!["u".into()], |_, u| 1.5 + u[0].sin())).unwrap();
+        // e1, f1, e2, f2, u
+        let point = [2.0, -0.5, 1.1, 0.8, 0.3];
+        for c in [[E, F], [F, E]] {
+            let ports = [(1, 1.0, c[0]), (1, -1.0, c[1])];
+            assert_eq!(check_partials(&tf, &ports, &point), Ok(2));
+        }
+    }
 
     #[test]
     fn rejects_zero_modulus() {

@@ -1,0 +1,98 @@
+//! The right-hand side and the Jacobian allocate nothing once warmed up: a counting global
+//! allocator watches 100 `rhs` calls and 10 `jacobian` calls at varying states, for every
+//! model in `models/` (performance guide: "no allocation in the rhs").
+//!
+//! The allocator counts every thread, so the tests of this file take one lock and load their
+//! models before they count.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::alloc::System;
+use std::sync::Mutex;
+
+use bg_tests::{is_refused, model_files};
+use bondgraph::{DMatrix, StateEquations};
+use stats_alloc::{Region, StatsAlloc, INSTRUMENTED_SYSTEM};
+
+#[global_allocator]
+static GLOBAL: &StatsAlloc<System> = &INSTRUMENTED_SYSTEM;
+
+static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+
+/// Models whose elements still allocate in the rhs: the crane's manipulator elements are
+/// being made allocation-free on another branch. Remove the line to check it here too.
+const NOT_YET: &[&str] = &[
+    "knuckle_boom", // manipulator elements (i_field, c_field, MTFs) allocate per call
+];
+
+/// Allocations (count, bytes) of 100 rhs calls, then of 10 Jacobians, at varying states.
+fn allocations(eqs: &StateEquations) -> ((usize, usize), (usize, usize)) {
+    let n = eqs.n_states();
+    let x0 = eqs.initial_state();
+    let states: Vec<Vec<f64>> = (0..100)
+        .map(|k| {
+            x0.iter()
+                .zip(eqs.states())
+                .enumerate()
+                .map(|(j, (x, s))| x + 1e-3 * s.nominal * ((j * 7 + k * 13) as f64).sin())
+                .collect()
+        })
+        .collect();
+    let mut dx = vec![0.0; n];
+    let mut jac = DMatrix::zeros(n, n);
+    eqs.rhs(0.0, &x0, &mut dx);
+    eqs.jacobian(0.0, &x0, &mut jac);
+    let region = Region::new(GLOBAL);
+    for (k, x) in states.iter().enumerate() {
+        eqs.rhs(1e-3 * k as f64, x, &mut dx);
+    }
+    let rhs = region.change();
+    let region = Region::new(GLOBAL);
+    for (k, x) in states.iter().take(10).enumerate() {
+        eqs.jacobian(1e-3 * k as f64, x, &mut jac);
+    }
+    let jacobian = region.change();
+    (
+        (rhs.allocations + rhs.reallocations, rhs.bytes_allocated),
+        (
+            jacobian.allocations + jacobian.reallocations,
+            jacobian.bytes_allocated,
+        ),
+    )
+}
+
+fn check(name: &str) {
+    let model = if name == "every_kind" {
+        bg_tests::every_kind().unwrap()
+    } else {
+        let path = bg_tests::root().join("models").join(format!("{name}.toml"));
+        bg_model::Model::load(&path, &bg_sim::registry(), &[]).unwrap()
+    };
+    let (rhs, jac) = allocations(&model.equations);
+    assert_eq!(rhs, (0, 0), "{name}: (allocations, bytes) in 100 rhs calls");
+    assert_eq!(jac, (0, 0), "{name}: (allocations, bytes) in 10 Jacobians");
+}
+
+#[test]
+fn rhs_and_jacobian_do_not_allocate() {
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let mut checked = Vec::new();
+    for path in model_files().into_iter().filter(|p| !is_refused(p)) {
+        let name = path.file_stem().unwrap().to_string_lossy().into_owned();
+        if !NOT_YET.contains(&name.as_str()) {
+            check(&name);
+            checked.push(name);
+        }
+    }
+    check("every_kind");
+    for must in ["mass_spring_damper", "cylinder_lift"] {
+        assert!(checked.iter().any(|c| c == must), "{must} not checked");
+    }
+}
+
+/// The crane: its manipulator elements allocate until their fix lands (see `NOT_YET`).
+#[test]
+#[ignore = "the manipulator elements still allocate; run with --ignored to see how much"]
+fn crane_rhs_and_jacobian_do_not_allocate() {
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    check("knuckle_boom");
+}
