@@ -11,7 +11,7 @@
 
 use nalgebra::{DMatrix, DVector, Vector2};
 
-use crate::arm::{PlanarArm, Pose};
+use crate::arm::{z_cross, PlanarArm, Pose};
 use crate::error::ManipulatorError;
 use crate::pin::{Pin, PinPoint};
 
@@ -93,14 +93,60 @@ impl PlanarArm {
 impl Pose<'_> {
     /// The length `l = |b − a|` of an actuator between resolved pins, with its gradient
     /// `∂l/∂q = (∂r_b/∂q − ∂r_a/∂q)ᵀ e` (e = (b − a)/l) written into `gradient` (length n):
-    /// a column of τ_b (eqs. 66–68), without allocating.
+    /// a column of τ_b (eqs. 66–68), without allocating. A joint that turns both pins turns
+    /// the actuator as a whole and leaves its length alone: its entry is exactly zero.
     pub fn actuator_length(&self, a: &PinPoint, b: &PinPoint, gradient: &mut [f64]) -> f64 {
         let d = self.pin_point_position(b) - self.pin_point_position(a);
         let l = d.norm();
         let e = d / l;
         gradient.fill(0.0);
-        self.add_pin_force(b, &e, gradient);
-        self.add_pin_force(a, &-e, gradient);
+        for (j, g) in gradient.iter_mut().enumerate().take(self.arm().n_links()) {
+            if !(turns(a, j) && turns(b, j)) {
+                *g = e.dot(&self.pin_pair_joint_column(a, b, j));
+            }
+        }
+        self.pin_pair_mode_columns(a, b, |k, col| gradient[k] += e.dot(&col));
         l
     }
+
+    /// `∂(r_b − r_a)/∂q_j` for joint j: `ẑ × (r_b − r_a)` if it turns both pins, else the
+    /// motion of the one it turns.
+    pub(crate) fn pin_pair_joint_column(
+        &self,
+        a: &PinPoint,
+        b: &PinPoint,
+        j: usize,
+    ) -> Vector2<f64> {
+        let (ra, rb) = (self.pin_point_position(a), self.pin_point_position(b));
+        let o = self.origin(j);
+        match (turns(a, j), turns(b, j)) {
+            (true, true) => z_cross(&(rb - ra)),
+            (false, true) => z_cross(&(rb - o)),
+            (true, false) => -z_cross(&(ra - o)),
+            (false, false) => Vector2::zeros(),
+        }
+    }
+
+    /// `∂(r_b − r_a)/∂q^b_k` for the modes of the pins' links: `column(k, ±ψ_k R_i ŷ)`.
+    pub(crate) fn pin_pair_mode_columns(
+        &self,
+        a: &PinPoint,
+        b: &PinPoint,
+        mut column: impl FnMut(usize, Vector2<f64>),
+    ) {
+        for (pin, sign) in [(b, 1.0), (a, -1.0)] {
+            if let PinPoint::Station(s) = pin {
+                let (c, sn) = self.cos_sin(s.link);
+                let o = self.arm().modal_offset(s.link);
+                for (k, psi) in s.psi.iter().enumerate() {
+                    column(o + k, sign * psi * Vector2::new(-sn, c));
+                }
+            }
+        }
+    }
+}
+
+/// Whether joint j turns the pin (a pin on link i is turned by the joints j ≤ i).
+pub(crate) fn turns(pin: &PinPoint, j: usize) -> bool {
+    pin.station().is_some_and(|s| j <= s.link)
 }

@@ -8,8 +8,12 @@ use nalgebra::DMatrix;
 /// A reusable Cholesky factorisation of an n×n matrix.
 #[derive(Clone, Debug)]
 pub(crate) struct Cholesky {
-    /// The lower triangle holds L; the strict upper triangle is not used.
-    l: DMatrix<f64>,
+    n: usize,
+    /// `U = Lᵀ`, column-major: column j holds row j of L, so every inner product below runs
+    /// over contiguous memory. The strict lower triangle is not used.
+    u: Vec<f64>,
+    /// `1 / U[j, j]`: the solves multiply instead of dividing.
+    inv_diag: Vec<f64>,
     ok: bool,
 }
 
@@ -17,7 +21,9 @@ impl Cholesky {
     /// Room for n×n matrices.
     pub(crate) fn new(n: usize) -> Self {
         Self {
-            l: DMatrix::zeros(n, n),
+            n,
+            u: vec![0.0; n * n],
+            inv_diag: vec![0.0; n],
             ok: false,
         }
     }
@@ -27,25 +33,25 @@ impl Cholesky {
     /// # Panics
     /// If `m` has another shape than the buffer.
     pub(crate) fn factor(&mut self, m: &DMatrix<f64>) -> bool {
-        let n = self.l.nrows();
+        let n = self.n;
         assert_eq!(m.shape(), (n, n), "matrix of another size");
         self.ok = false;
         for j in 0..n {
-            let mut d = m[(j, j)];
-            for k in 0..j {
-                d -= self.l[(j, k)] * self.l[(j, k)];
-            }
+            let tail = &mut self.u[j * n..];
+            let col_j = &mut tail[..n];
+            let d = m[(j, j)] - dot(&col_j[..j], &col_j[..j]);
             if !(d > 0.0 && d.is_finite()) {
                 return false;
             }
-            let ljj = d.sqrt();
-            self.l[(j, j)] = ljj;
+            let ujj = d.sqrt();
+            col_j[j] = ujj;
+            let inv = 1.0 / ujj;
+            self.inv_diag[j] = inv;
+            // U[j, i] = (M[i, j] − U[..j, i]·U[..j, j]) / U[j, j] for i > j (row j of U).
             for i in j + 1..n {
-                let mut s = m[(i, j)];
-                for k in 0..j {
-                    s -= self.l[(i, k)] * self.l[(j, k)];
-                }
-                self.l[(i, j)] = s / ljj;
+                let (left, right) = tail.split_at_mut((i - j) * n);
+                let s = dot(&right[..j], &left[..j]);
+                right[j] = (m[(i, j)] - s) * inv;
             }
         }
         self.ok = true;
@@ -54,20 +60,30 @@ impl Cholesky {
 
     /// `b ← M⁻¹ b` with the last factor (NaN if it failed).
     pub(crate) fn solve_in_place(&self, b: &mut [f64]) {
-        let n = self.l.nrows();
+        let n = self.n;
         if !self.ok {
             b.fill(f64::NAN);
             return;
         }
+        // Uᵀ y = b
         for i in 0..n {
-            let s: f64 = (0..i).map(|k| self.l[(i, k)] * b[k]).sum();
-            b[i] = (b[i] - s) / self.l[(i, i)];
+            let col = &self.u[i * n..(i + 1) * n];
+            b[i] = (b[i] - dot(&col[..i], &b[..i])) * self.inv_diag[i];
         }
-        for i in (0..n).rev() {
-            let s: f64 = (i + 1..n).map(|k| self.l[(k, i)] * b[k]).sum();
-            b[i] = (b[i] - s) / self.l[(i, i)];
+        // U x = y
+        for k in (0..n).rev() {
+            let col = &self.u[k * n..(k + 1) * n];
+            let xk = b[k] * self.inv_diag[k];
+            b[k] = xk;
+            for (bi, uik) in b[..k].iter_mut().zip(&col[..k]) {
+                *bi -= uik * xk;
+            }
         }
     }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 #[cfg(test)]

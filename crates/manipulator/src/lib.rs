@@ -48,6 +48,7 @@ mod cholesky;
 pub mod elements;
 pub mod error;
 pub mod gravity;
+pub mod hessians;
 pub mod joint;
 pub mod kinematics;
 pub mod kinetic_forces;

@@ -9,14 +9,19 @@
 //! from 1, or from [`numbered_from`](ActuatorTransformer::numbered_from)): `l{c}` (m) and
 //! `ldot{c}` (m/s, computed from the flow on port 1 whatever the bond's direction), each in a
 //! stage of its own (the right-hand side skips `ldot{c}` unless an element reads it).
+//!
+//! Partials: besides the MTF law's (`τ_b`, `−τ_bᵀ`), the modulation's through q, with the
+//! Hessian `∇²l_c` of each length ([`hessians`](crate::hessians)):
+//! `∂e₁/∂q = Σ_c e₂_c ∇²l_c`, `∂f_in₂_c/∂q = −∇²l_c f_in₁`, `∂l_c/∂q = τ_b[:, c]`.
 
 use std::cell::RefCell;
 use std::sync::Arc;
 
 use bondgraph::{
-    CausalRule, Element, Io, ParamError, PortCausality, PortSpec, Ports, SignalSpec, Slot, Stage,
+    CausalRule, Element, Io, LocalJacobian, ParamError, PortCausality, PortSpec, Ports, SignalSpec,
+    Slot, Stage,
 };
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, Vector2};
 
 use super::last_argument::LastArgument;
 use super::mtf_law;
@@ -42,6 +47,10 @@ struct Modulus {
     frames: Frames,
     tau: DMatrix<f64>,
     lengths: Vec<f64>,
+    /// The configuration of the last partials, `∇²l_c` there, and scratch.
+    jac_q: LastArgument,
+    hessians: Vec<DMatrix<f64>>,
+    jd: Vec<Vector2<f64>>,
 }
 
 impl Modulus {
@@ -54,6 +63,16 @@ impl Modulus {
         for (c, (a, b)) in pins.iter().enumerate() {
             let column = &mut self.tau.as_mut_slice()[c * n..(c + 1) * n];
             self.lengths[c] = pose.actuator_length(a, b, column);
+        }
+    }
+
+    fn update_hessians(&mut self, arm: &PlanarArm, pins: &[(PinPoint, PinPoint)], q: &[f64]) {
+        if self.jac_q.is_same(q) {
+            return;
+        }
+        let pose = arm.pose_in(self.jac_q.get(), &mut self.frames);
+        for ((a, b), h) in pins.iter().zip(&mut self.hessians) {
+            pose.actuator_length_hessian(a, b, &mut self.jd, h);
         }
     }
 }
@@ -84,6 +103,9 @@ impl ActuatorTransformer {
                 frames: arm.frames(),
                 tau: DMatrix::zeros(n, acts.len()),
                 lengths: vec![0.0; acts.len()],
+                jac_q: LastArgument::new(n),
+                hessians: vec![DMatrix::zeros(n, n); acts.len()],
+                jd: vec![Vector2::zeros(); n],
             }),
             arm,
             pins,
@@ -159,5 +181,58 @@ impl Element for ActuatorTransformer {
                 }
             }
         }
+    }
+    fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        let mut ws = self.ws.borrow_mut();
+        ws.update(&self.arm, &self.pins, io.input(0));
+        ws.update_hessians(&self.arm, &self.pins, io.input(0));
+        let (n, n_act) = (self.arm.n(), self.pins.len());
+        match stage {
+            0 => {
+                mtf_law::effort_partials(jac, &ws.tau);
+                for k in 0..n {
+                    let row = jac.row(Slot::Effort(0), k);
+                    for l in 0..n {
+                        let v: f64 = (0..n_act)
+                            .map(|c| io.e(1, c) * ws.hessians[c][(k, l)])
+                            .sum();
+                        jac.set(row, jac.input_col(0, l), v);
+                    }
+                }
+            }
+            1 => {
+                mtf_law::flow_partials(jac, &ws.tau);
+                for (c, h) in ws.hessians.iter().enumerate() {
+                    let row = jac.row(Slot::Flow(1), c);
+                    for l in 0..n {
+                        let v: f64 = (0..n).map(|k| h[(k, l)] * io.f_in(0, k)).sum();
+                        jac.set(row, jac.input_col(0, l), -v);
+                    }
+                }
+            }
+            2 => {
+                for c in 0..n_act {
+                    let row = jac.row(Slot::Output(c), 0);
+                    for l in 0..n {
+                        jac.set(row, jac.input_col(0, l), ws.tau[(l, c)]);
+                    }
+                }
+            }
+            _ => {
+                // ldot_c = Σ_k τ_b[k, c] · (bond flow)_k, bond flow = sign · f_in
+                let sign = io.sign(0);
+                for (c, h) in ws.hessians.iter().enumerate() {
+                    let row = jac.row(Slot::Output(n_act + c), 0);
+                    for k in 0..n {
+                        jac.set(row, jac.flow_col(0, k), sign * ws.tau[(k, c)]);
+                    }
+                    for l in 0..n {
+                        let v: f64 = (0..n).map(|k| h[(k, l)] * io.flow(0)[k]).sum();
+                        jac.set(row, jac.input_col(0, l), v);
+                    }
+                }
+            }
+        }
+        true
     }
 }

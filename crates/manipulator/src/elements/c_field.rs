@@ -5,12 +5,15 @@
 //! `<arm>.q`, so the field stores the potential energy `V(q) = V_g(q) + ½ qᵀK q` without
 //! states of its own: the power on its port, `eᵀ u = (−G + K q)ᵀ q̇ = dV/dt`, is exactly the
 //! rate of V. Causality is fixed (effort out). Publishes `V` (J) in a stage of its own, which
-//! the right-hand side skips unless another element reads it.
+//! the right-hand side skips unless another element reads it. Partials: `∂e/∂q = K + ∂²V_g/∂q²`
+//! ([`hessians`](crate::hessians)), `∂V/∂q = e`.
 
 use std::cell::RefCell;
 use std::sync::Arc;
 
-use bondgraph::{CausalRule, Element, Io, PortCausality, PortSpec, Ports, SignalSpec, Slot, Stage};
+use bondgraph::{
+    CausalRule, Element, Io, LocalJacobian, PortCausality, PortSpec, Ports, SignalSpec, Slot, Stage,
+};
 use nalgebra::{DMatrix, DVector};
 
 use super::last_argument::LastArgument;
@@ -33,6 +36,9 @@ struct Workspace {
     frames: Frames,
     g: Vec<f64>,
     v_g: f64,
+    /// The configuration of the last partials, and `∂²V_g/∂q²` there.
+    jac_q: LastArgument,
+    gravity_hessian: DMatrix<f64>,
 }
 
 impl Workspace {
@@ -40,6 +46,13 @@ impl Workspace {
         if !self.q.is_same(q) {
             let kin = ArmKinematics::new(arm.pose_in(self.q.get(), &mut self.frames));
             self.v_g = kin.gravity_into(&mut self.g);
+        }
+    }
+
+    fn update_hessian(&mut self, arm: &PlanarArm, q: &[f64]) {
+        if !self.jac_q.is_same(q) {
+            let kin = ArmKinematics::new(arm.pose_in(self.jac_q.get(), &mut self.frames));
+            kin.gravity_hessian_into(&mut self.gravity_hessian);
         }
     }
 }
@@ -56,6 +69,8 @@ impl ArmCompliance {
                 frames: arm.frames(),
                 g: vec![0.0; n],
                 v_g: 0.0,
+                jac_q: LastArgument::new(n),
+                gravity_hessian: DMatrix::zeros(n, n),
             }),
             arm,
             q_signal: q_signal.to_owned(),
@@ -121,5 +136,32 @@ impl Element for ArmCompliance {
         } else {
             io.set_y(0, 0, ws.v_g + PlanarArm::strain_energy(&self.k, q));
         }
+    }
+    fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        let n = self.arm.n();
+        let mut ws = self.ws.borrow_mut();
+        ws.update(&self.arm, io.input(0));
+        if stage == 0 {
+            ws.update_hessian(&self.arm, io.input(0));
+            for k in 0..n {
+                let row = jac.row(Slot::Effort(0), k);
+                for l in 0..n {
+                    let v = self.k[(k, l)] + ws.gravity_hessian[(k, l)];
+                    jac.set(row, jac.input_col(0, l), v);
+                }
+            }
+        } else {
+            let row = jac.row(Slot::Output(0), 0);
+            let q = ws.q.get();
+            for (l, gl) in ws.g.iter().enumerate() {
+                let kq: f64 = q
+                    .iter()
+                    .enumerate()
+                    .map(|(m, qm)| self.k[(l, m)] * qm)
+                    .sum();
+                jac.set(row, jac.input_col(0, l), kq - gl);
+            }
+        }
+        true
     }
 }

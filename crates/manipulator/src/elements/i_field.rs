@@ -30,15 +30,23 @@
 //! `x_e{i}`, `y_e{i}`, `w{i}_mid`) and 3 (the named coordinates) write only signals, so the
 //! right-hand side skips them unless another element reads them. Nothing allocates after
 //! construction: M, its factor and the vectors live in a workspace.
+//!
+//! # Partials (for the exact Jacobian)
+//! With `B = ∂²T/∂u∂q` (column k = `(∂M/∂q_k) u`) and `H = ∂²T/∂q²`
+//! ([`hessians`](crate::hessians)): `∂u/∂p = M⁻¹`, `∂u/∂q = −M⁻¹B`, and
+//! `∂ṗ/∂e = I`, `∂ṗ/∂p = BᵀM⁻¹`, `∂ṗ/∂q = H − BᵀM⁻¹B` (since `∂E/∂u = Bᵀ`). Stages 0, 2 and 3
+//! and the derivatives give them analytically; `udot` (stage 1) is left to the core.
 
 use std::cell::RefCell;
 use std::sync::Arc;
 
 use bondgraph::{
-    component_names, CausalRule, Element, Io, ParamError, PortCausality, PortSpec, Ports,
-    SignalSpec, Slot, Stage, StateSpec,
+    component_names, CausalRule, Element, Io, LocalJacobian, ParamError, PortCausality, PortSpec,
+    Ports, SignalSpec, Slot, Stage, StateSpec,
 };
 use nalgebra::{DMatrix, DVector};
+
+use crate::arm::z_cross;
 
 use super::last_argument::LastArgument;
 use crate::arm::{Frames, PlanarArm, Station};
@@ -71,6 +79,12 @@ struct Motion {
     mdot_u_valid: bool,
     udot: Vec<f64>,
     kinetic: f64,
+    /// The state of the last partials, and M⁻¹, B, M⁻¹B and `H − BᵀM⁻¹B` there.
+    jac_state: LastArgument,
+    minv: DMatrix<f64>,
+    b: DMatrix<f64>,
+    minv_b: DMatrix<f64>,
+    dpdot_dq: DMatrix<f64>,
 }
 
 const OUT_U: usize = 0;
@@ -94,6 +108,11 @@ impl Motion {
             mdot_u_valid: false,
             udot: vec![0.0; n],
             kinetic: 0.0,
+            jac_state: LastArgument::new(2 * n),
+            minv: DMatrix::zeros(n, n),
+            b: DMatrix::zeros(n, n),
+            minv_b: DMatrix::zeros(n, n),
+            dpdot_dq: DMatrix::zeros(n, n),
         }
     }
 
@@ -122,6 +141,43 @@ impl Motion {
         kin.kinetic_terms_into(u, e, None);
         *kinetic = 0.5 * u.iter().zip(p).map(|(a, b)| a * b).sum::<f64>();
         *mdot_u_valid = false;
+    }
+
+    /// M⁻¹, B, M⁻¹B and `H − BᵀM⁻¹B` at the last state (after [`update`](Self::update)).
+    fn partials(&mut self, arm: &PlanarArm) {
+        let Self {
+            state,
+            frames,
+            factor,
+            u,
+            jac_state,
+            minv,
+            b,
+            minv_b,
+            dpdot_dq,
+            ..
+        } = self;
+        if jac_state.is_same(state.get()) {
+            return;
+        }
+        let n = arm.n();
+        let kin = ArmKinematics::new(arm.pose_in(&state.get()[n..], frames));
+        kin.kinetic_partials_into(u, b, dpdot_dq);
+        for (k, col) in minv.as_mut_slice().chunks_mut(n).enumerate() {
+            col.fill(0.0);
+            col[k] = 1.0;
+            factor.solve_in_place(col);
+        }
+        minv_b.copy_from(b);
+        for col in minv_b.as_mut_slice().chunks_mut(n) {
+            factor.solve_in_place(col);
+        }
+        for c in 0..n {
+            for r in 0..n {
+                let bt_x: f64 = (0..n).map(|a| b[(a, r)] * minv_b[(a, c)]).sum();
+                dpdot_dq[(r, c)] -= bt_x;
+            }
+        }
     }
 
     /// Ṁu at the last state.
@@ -343,6 +399,90 @@ impl Element for ArmInertia {
             dx[k] = io.e(0, k) + ws.e[k];
             dx[n + k] = ws.u[k];
         }
+    }
+    fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        let n = self.arm.n();
+        let mut ws = self.ws.borrow_mut();
+        ws.update(&self.arm, io.states());
+        ws.partials(&self.arm);
+        // ∂u_k/∂(p, q) into row `row`.
+        let speed_row = |jac: &mut LocalJacobian<'_>, row: usize, k: usize, ws: &Motion| {
+            for c in 0..n {
+                jac.set(row, jac.state_col(c), ws.minv[(k, c)]);
+                jac.set(row, jac.state_col(n + c), -ws.minv_b[(k, c)]);
+            }
+        };
+        match stage {
+            0 => {
+                for k in 0..n {
+                    speed_row(jac, jac.row(Slot::Flow(0), k), k, &ws);
+                    speed_row(jac, jac.row(Slot::Output(OUT_U), k), k, &ws);
+                }
+            }
+            1 => return false,
+            2 => {
+                // T: ∂T/∂p = u, ∂T/∂q|_p = −E
+                let row = jac.row(Slot::Output(OUT_T), 0);
+                for c in 0..n {
+                    jac.set(row, jac.state_col(c), ws.u[c]);
+                    jac.set(row, jac.state_col(n + c), -ws.e[c]);
+                }
+                let Motion { state, frames, .. } = &mut *ws;
+                let pose = self.arm.pose_in(&state.get()[n..], frames);
+                for i in 0..self.arm.n_links() {
+                    let end = pose.origin(i + 1);
+                    let (rx, ry) = (
+                        jac.row(Slot::Output(OUT_LINKS + 3 * i), 0),
+                        jac.row(Slot::Output(OUT_LINKS + 3 * i + 1), 0),
+                    );
+                    for j in 0..=i {
+                        let d = z_cross(&(end - pose.origin(j)));
+                        jac.set(rx, jac.state_col(n + j), d.x);
+                        jac.set(ry, jac.state_col(n + j), d.y);
+                    }
+                    if let Some(s) = &self.mid[i] {
+                        let rw = jac.row(Slot::Output(OUT_LINKS + 3 * i + 2), 0);
+                        let o = self.arm.modal_offset(i);
+                        for (k, psi) in s.psi.iter().enumerate() {
+                            jac.set(rw, jac.state_col(n + o + k), *psi);
+                        }
+                    }
+                }
+            }
+            _ => {
+                let first = self.first_named_output();
+                for (j, (_, _, index)) in self.named.iter().enumerate() {
+                    if let Some(k) = *index {
+                        let row = jac.row(Slot::Output(first + 2 * j), 0);
+                        jac.set(row, jac.state_col(n + k), 1.0);
+                        speed_row(jac, jac.row(Slot::Output(first + 2 * j + 1), 0), k, &ws);
+                    }
+                }
+            }
+        }
+        true
+    }
+    fn derivative_partials(&self, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        let n = self.arm.n();
+        let mut ws = self.ws.borrow_mut();
+        ws.update(&self.arm, io.states());
+        ws.partials(&self.arm);
+        for r in 0..n {
+            // ṗ = e + E(q, u(p, q))
+            let row = jac.derivative_row(r);
+            jac.set(row, jac.effort_col(0, r), 1.0);
+            for c in 0..n {
+                jac.set(row, jac.state_col(c), ws.minv_b[(c, r)]);
+                jac.set(row, jac.state_col(n + c), ws.dpdot_dq[(r, c)]);
+            }
+            // q̇ = u(p, q)
+            let row = jac.derivative_row(n + r);
+            for c in 0..n {
+                jac.set(row, jac.state_col(c), ws.minv[(r, c)]);
+                jac.set(row, jac.state_col(n + c), -ws.minv_b[(r, c)]);
+            }
+        }
+        true
     }
     fn stored_energy(&self, x: &[f64]) -> Option<f64> {
         let mut ws = self.ws.borrow_mut();

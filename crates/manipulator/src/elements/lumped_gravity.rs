@@ -1,7 +1,9 @@
 //! Gravity on the lumped cylinder masses (eq. 76): an effort source
 //! `e = −g [0 m₁ 0 m₂ …]ᵀ` (frame 0, x then y per mass).
 
-use bondgraph::{CausalRule, Element, Io, ParamError, PortCausality, PortSpec, Ports, Stage};
+use bondgraph::{
+    CausalRule, Element, Io, LocalJacobian, ParamError, PortCausality, PortSpec, Ports, Stage,
+};
 
 /// The weights of point masses, as a multiport effort source.
 #[derive(Debug)]
@@ -42,5 +44,8 @@ impl Element for LumpedGravity {
             io.set_e(0, 2 * k, 0.0);
             io.set_e(0, 2 * k + 1, -m * self.g);
         }
+    }
+    fn stage_partials(&self, _: usize, _: &Io<'_>, _: &mut LocalJacobian<'_>) -> bool {
+        true // constant weights
     }
 }

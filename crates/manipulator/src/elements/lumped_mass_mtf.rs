@@ -6,14 +6,19 @@
 //! x then y per pin) applied *to the mechanism* at the pins — the spring–damper forces of
 //! the lumped masses — and f_in₂ the pin velocities. The paper writes the same relation with
 //! the ports named the other way round (`f_01 = J_c f_5`, `e_5 = J_cᵀ e_01`).
+//!
+//! Partials: besides the MTF law's (`J_cᵀ`, `−J_c`), the modulation's through q, with the
+//! second derivatives of the pin positions ([`hessians`](crate::hessians)):
+//! `∂e₁/∂q = Σ_pins e₂_pin · ∂²r_pin/∂q²`, `∂f_in₂/∂q = −(∂²r_pin/∂q²) f_in₁`.
 
 use std::cell::RefCell;
 use std::sync::Arc;
 
 use bondgraph::{
-    CausalRule, Element, Io, ParamError, PortCausality, PortSpec, Ports, SignalSpec, Stage,
+    CausalRule, Element, Io, LocalJacobian, ParamError, PortCausality, PortSpec, Ports, SignalSpec,
+    Slot, Stage,
 };
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, Vector2};
 
 use super::last_argument::LastArgument;
 use super::mtf_law;
@@ -120,5 +125,34 @@ impl Element for LumpedMassTransformer {
         } else {
             mtf_law::set_flow(io, &ws.jt);
         }
+    }
+    fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        let mut ws = self.ws.borrow_mut();
+        ws.update(&self.arm, &self.stations, io.input(0));
+        let Modulus { q, frames, jt } = &mut *ws;
+        let pose = self.arm.pose_in(q.get(), frames);
+        if stage == 0 {
+            mtf_law::effort_partials(jac, jt);
+            for (p, s) in self.stations.iter().enumerate() {
+                let f = Vector2::new(io.e(1, 2 * p), io.e(1, 2 * p + 1));
+                pose.point_hessian(s, |a, b, v| {
+                    jac.add(jac.row(Slot::Effort(0), a), jac.input_col(0, b), f.dot(&v));
+                });
+            }
+        } else {
+            mtf_law::flow_partials(jac, jt);
+            for (p, s) in self.stations.iter().enumerate() {
+                let (rx, ry) = (
+                    jac.row(Slot::Flow(1), 2 * p),
+                    jac.row(Slot::Flow(1), 2 * p + 1),
+                );
+                pose.point_hessian(s, |a, b, v| {
+                    let f = io.f_in(0, a);
+                    jac.add(rx, jac.input_col(0, b), -v.x * f);
+                    jac.add(ry, jac.input_col(0, b), -v.y * f);
+                });
+            }
+        }
+        true
     }
 }

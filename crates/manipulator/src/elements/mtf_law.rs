@@ -2,7 +2,7 @@
 //! convention (`bondgraph::MatrixTransformer`): `e₁ = T e₂`, `f_in₂ = −Tᵀ f_in₁`. Power is
 //! conserved for every T: `e₁ᵀf_in₁ + e₂ᵀf_in₂ = e₂ᵀTᵀf_in₁ − e₂ᵀTᵀf_in₁ = 0`.
 
-use bondgraph::{Io, Slot, Stage};
+use bondgraph::{Io, LocalJacobian, Slot, Stage};
 use nalgebra::DMatrix;
 
 /// Stage 0 writes e₁ from e₂, stage 1 writes f₂ from f₁; both read the modulating signal
@@ -28,4 +28,14 @@ pub(crate) fn set_effort(io: &mut Io<'_>, t: &DMatrix<f64>) {
 /// `f_in₂ = −Tᵀ f_in₁`.
 pub(crate) fn set_flow(io: &mut Io<'_>, t: &DMatrix<f64>) {
     bondgraph::apply_flow(io, t);
+}
+
+/// `∂e₁/∂e₂ = T` (the modulation's partials are the caller's).
+pub(crate) fn effort_partials(jac: &mut LocalJacobian<'_>, t: &DMatrix<f64>) {
+    bondgraph::effort_partials(jac, t);
+}
+
+/// `∂f_in₂/∂f_in₁ = −Tᵀ` (the modulation's partials are the caller's).
+pub(crate) fn flow_partials(jac: &mut LocalJacobian<'_>, t: &DMatrix<f64>) {
+    bondgraph::flow_partials(jac, t);
 }

@@ -5,7 +5,9 @@
 //! the arm's 1-junction gives it), so a scheduled event can switch them by rebuilding the
 //! element with other values: the shape, causality and stages stay the same.
 
-use bondgraph::{CausalRule, Element, Io, ParamError, PortCausality, PortSpec, Ports};
+use bondgraph::{
+    CausalRule, Element, Io, LocalJacobian, ParamError, PortCausality, PortSpec, Ports, Slot,
+};
 
 /// Diagonal generalized damping.
 #[derive(Debug)]
@@ -45,6 +47,12 @@ impl Element for ArmDamping {
             let e = d * io.f_in(0, k);
             io.set_e(0, k, e);
         }
+    }
+    fn stage_partials(&self, _: usize, _: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        for (k, d) in self.d.iter().enumerate() {
+            jac.set(jac.row(Slot::Effort(0), k), jac.flow_col(0, k), *d);
+        }
+        true
     }
 }
 
