@@ -191,6 +191,16 @@ impl LocalShape {
 pub struct LocalJacobian<'a> {
     shape: &'a LocalShape,
     values: &'a mut [f64],
+    /// The entries set so far, when the core keeps a list of them (so that it reads, and
+    /// zeroes again, only those).
+    touched: Option<Touched<'a>>,
+}
+
+/// The list of entries a [`LocalJacobian`] has set, and a mark per entry.
+#[derive(Debug)]
+pub(crate) struct Touched<'a> {
+    pub(crate) list: &'a mut Vec<usize>,
+    pub(crate) mark: &'a mut [bool],
 }
 
 impl<'a> LocalJacobian<'a> {
@@ -200,7 +210,36 @@ impl<'a> LocalJacobian<'a> {
     /// If `values` does not have `shape.len()` entries.
     pub fn new(shape: &'a LocalShape, values: &'a mut [f64]) -> Self {
         assert_eq!(values.len(), shape.len(), "local Jacobian buffer size");
-        Self { shape, values }
+        Self {
+            shape,
+            values,
+            touched: None,
+        }
+    }
+
+    /// As [`new`](Self::new), keeping the list of entries set in `touched` (its marks all
+    /// false and `values` all zero on entry; `list` has room for every entry, so pushing
+    /// never allocates).
+    pub(crate) fn tracked(
+        shape: &'a LocalShape,
+        values: &'a mut [f64],
+        touched: Touched<'a>,
+    ) -> Self {
+        assert_eq!(values.len(), shape.len(), "local Jacobian buffer size");
+        Self {
+            shape,
+            values,
+            touched: Some(touched),
+        }
+    }
+
+    fn note(&mut self, index: usize) {
+        if let Some(t) = &mut self.touched {
+            if !t.mark[index] {
+                t.mark[index] = true;
+                t.list.push(index);
+            }
+        }
     }
 
     /// The shape (rows and columns).
@@ -263,12 +302,16 @@ impl<'a> LocalJacobian<'a> {
 
     /// Set entry (row, col).
     pub fn set(&mut self, row: usize, col: usize, v: f64) {
-        self.values[row * self.shape.n_cols + col] = v;
+        let i = row * self.shape.n_cols + col;
+        self.values[i] = v;
+        self.note(i);
     }
 
     /// Add `v` to entry (row, col).
     pub fn add(&mut self, row: usize, col: usize, v: f64) {
-        self.values[row * self.shape.n_cols + col] += v;
+        let i = row * self.shape.n_cols + col;
+        self.values[i] += v;
+        self.note(i);
     }
 
     /// Entry (row, col).
@@ -279,7 +322,16 @@ impl<'a> LocalJacobian<'a> {
 
     /// Set every entry to zero.
     pub fn zero(&mut self) {
-        self.values.fill(0.0);
+        match &mut self.touched {
+            Some(t) => {
+                for &i in t.list.iter() {
+                    self.values[i] = 0.0;
+                    t.mark[i] = false;
+                }
+                t.list.clear();
+            }
+            None => self.values.fill(0.0),
+        }
     }
 
     /// The values, row-major.

@@ -16,7 +16,7 @@
 use nalgebra::DMatrix;
 
 use crate::element::{Element, Io, Layout, Slot, Source};
-use crate::local_jacobian::{LocalJacobian, LocalShape};
+use crate::local_jacobian::{LocalJacobian, LocalShape, Touched};
 
 use super::StateEquations;
 
@@ -49,8 +49,8 @@ pub(super) struct BlockPlan {
     /// Per local row: the gradient slot (or, for derivatives, the state index) it fills, the
     /// factor from the local value to the stored one (±1 for `f_in` rows) and its cell.
     rows: Vec<(usize, f64, Cell)>,
-    /// Local columns that depend on x and are not written by the stage.
-    cols: Vec<(usize, Dep)>,
+    /// Per local column, its dependence on x (`Dep::None` for the columns the stage writes).
+    col_dep: Vec<Dep>,
     /// Scalars perturbed by the local difference, with their dependence on x.
     fd: Vec<(Cell, Dep)>,
 }
@@ -74,8 +74,11 @@ pub(super) struct JacobianWork {
     /// Row accumulators (max_rows × n) and their ranges.
     acc: Vec<f64>,
     acc_range: Vec<(usize, usize)>,
-    /// A local Jacobian block.
+    /// A local Jacobian block (all zero between blocks), the entries an element set in it and
+    /// their marks.
     local: Vec<f64>,
+    touched: Vec<usize>,
+    mark: Vec<bool>,
     /// Row values at the evaluation point, and perturbed.
     base: Vec<f64>,
     plus: Vec<f64>,
@@ -175,11 +178,10 @@ impl StateEquations {
                         written.extend(col);
                     }
                 }
-                let cols = deps
+                let col_dep = deps
                     .iter()
                     .enumerate()
-                    .filter(|&(c, d)| *d != Dep::None && !written.contains(&c))
-                    .map(|(c, d)| (c, *d))
+                    .map(|(c, d)| if written.contains(&c) { Dep::None } else { *d })
                     .collect();
                 let mut cells: Vec<Option<Cell>> = Vec::new();
                 for &slot in &stage.reads {
@@ -203,7 +205,7 @@ impl StateEquations {
                 stages.push(BlockPlan {
                     shape,
                     rows,
-                    cols,
+                    col_dep,
                     fd,
                 });
             }
@@ -219,12 +221,7 @@ impl StateEquations {
                     (i, 1.0, Cell::Derivative(i))
                 })
                 .collect();
-            let cols = deps
-                .iter()
-                .enumerate()
-                .filter(|(_, d)| **d != Dep::None)
-                .map(|(c, d)| (c, *d))
-                .collect();
+            let col_dep = deps.clone();
             let mut cells: Vec<Option<Cell>> = Vec::new();
             for p in &l.ports {
                 cells.extend((0..p.dim).map(|k| Some(Cell::Effort(p.offset + k))));
@@ -240,7 +237,7 @@ impl StateEquations {
             plan.derivatives.push(Some(BlockPlan {
                 shape,
                 rows,
-                cols,
+                col_dep,
                 fd,
             }));
         }
@@ -272,6 +269,8 @@ impl StateEquations {
             acc: vec![0.0; p.max_rows * n],
             acc_range: vec![EMPTY; p.max_rows],
             local: vec![0.0; p.max_local],
+            touched: Vec::with_capacity(p.max_local),
+            mark: vec![false; p.max_local],
             base: vec![0.0; p.max_rows],
             plus: vec![0.0; p.max_rows],
             x: vec![0.0; n],
@@ -377,9 +376,12 @@ impl Block<'_> {
     fn partials(&mut self, id: usize, target: Target, plan: &BlockPlan) -> bool {
         let layout = &self.eqs.layouts[id];
         let element: &dyn Element = self.eqs.graph.node(id).element.as_ref();
-        let local = &mut self.w.local[..plan.shape.len()];
-        local.fill(0.0);
-        let mut jac = LocalJacobian::new(&plan.shape, local);
+        let len = plan.shape.len();
+        let touched = Touched {
+            list: &mut self.w.touched,
+            mark: &mut self.w.mark[..len],
+        };
+        let mut jac = LocalJacobian::tracked(&plan.shape, &mut self.w.local[..len], touched);
         let io = Io {
             t: self.t,
             x: &self.w.x,
@@ -470,16 +472,19 @@ impl Block<'_> {
 
     /// Fill the accumulator rows of a block: analytic partials, or a local difference.
     fn rows(&mut self, id: usize, target: Target, plan: &BlockPlan) {
-        if self.partials(id, target, plan) {
-            let nc = plan.shape.n_cols();
-            for (r, &(_, scale, _)) in plan.rows.iter().enumerate() {
-                for &(c, dep) in &plan.cols {
-                    let v = self.w.local[r * nc + c];
-                    if v != 0.0 {
-                        self.add(r, v * scale, dep);
-                    }
-                }
+        let gives = self.partials(id, target, plan);
+        let nc = plan.shape.n_cols();
+        for k in 0..self.w.touched.len() {
+            let i = self.w.touched[k];
+            let v = std::mem::take(&mut self.w.local[i]);
+            self.w.mark[i] = false;
+            let (r, c) = (i / nc, i % nc);
+            if gives && v != 0.0 {
+                self.add(r, v * plan.rows[r].1, plan.col_dep[c]);
             }
+        }
+        self.w.touched.clear();
+        if gives {
             return;
         }
         let m = plan.rows.len();
