@@ -67,5 +67,6 @@ pub use equations::{Probe, StateEquations, StateInfo};
 pub use error::{CausalityError, Error, GraphError, ParamError, SimulationError};
 pub use graph::{BondGraph, Node};
 pub use simulate::{
-    simulate, Event, Method, Outcome, Output, Settings, Statistics, Trajectory, WatchReport,
+    check_in_memory, simulate, simulate_into, Event, Method, Outcome, Output, RowSink, Settings,
+    Statistics, Trajectory, WatchReport, MAX_OUTPUT_ROWS, MAX_VALUES_IN_MEMORY, MIN_RTOL,
 };
