@@ -118,11 +118,7 @@ pub fn clip(s: &str) -> String {
 fn clip_to(s: &str, max: usize) -> String {
     match s.char_indices().nth(max) {
         None => s.to_owned(),
-        Some((i, _)) => format!(
-            "{}… ({} more characters)",
-            &s[..i],
-            s[i..].chars().count()
-        ),
+        Some((i, _)) => format!("{}… ({} more characters)", &s[..i], s[i..].chars().count()),
     }
 }
 

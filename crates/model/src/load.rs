@@ -164,9 +164,11 @@ impl<'a> CheckSink<'a> {
         for c in &model.checks {
             let compile = |e: &Expr| {
                 e.compile(&constant, &columns).map_err(|m| {
-                    model
-                        .source
-                        .err(ErrorKind::Settings, None, format!("[[check]] {}: {m}", clip(&c.value)))
+                    model.source.err(
+                        ErrorKind::Settings,
+                        None,
+                        format!("[[check]] {}: {m}", clip(&c.value)),
+                    )
                 })
             };
             compiled.push((compile(&c.value_expr)?, compile(&c.expected_expr)?));
@@ -372,7 +374,10 @@ impl Source {
                         .err(
                             ErrorKind::BadParameter,
                             Some(&exprs[name].span),
-                            format!("parameter `{name}` uses `{}`, which is not a parameter", clip(&n)),
+                            format!(
+                                "parameter `{name}` uses `{}`, which is not a parameter",
+                                clip(&n)
+                            ),
                         )
                         .hint(format!(
                             "parameters may only use numbers and other parameters; known: {}",
@@ -682,7 +687,7 @@ fn read_model(path: &Path, file: &str) -> Result<String, ModelError> {
             ErrorKind::Syntax,
             file,
             format!(
-                "not UTF-8 text: byte {at} (0x{:02x}) is not valid UTF-8",
+                "not UTF-8 text: the byte at offset {at} (0x{:02x}) is not valid UTF-8",
                 bytes.get(at).copied().unwrap_or(0)
             ),
         )
@@ -882,7 +887,10 @@ fn build_graph(p: &mut Parsed) -> Result<BondGraph, ModelError> {
         let (a, b) = text.get_ref().split_once("->").ok_or_else(|| {
             err(
                 ErrorKind::Syntax,
-                format!("`{}` is not of the form \"from -> to\"", clip(text.get_ref())),
+                format!(
+                    "`{}` is not of the form \"from -> to\"",
+                    clip(text.get_ref())
+                ),
             )
             .hint("the arrow points in the direction of positive power: \"source -> junction\"")
         })?;
@@ -1262,7 +1270,8 @@ pub fn valid_column_name(n: &str) -> bool {
     let mut c = n.chars();
     n.chars().count() <= MAX_COLUMN_NAME
         && !RESERVED.contains(&n)
-        && c.next().is_some_and(|f| f.is_ascii_alphabetic() || f == '_')
+        && c.next()
+            .is_some_and(|f| f.is_ascii_alphabetic() || f == '_')
         && c.all(|ch| ch.is_ascii_alphanumeric() || "_.[]".contains(ch))
 }
 
@@ -1335,7 +1344,10 @@ fn read_outputs(
                             what(eqs.probe(other))
                         ),
                     )
-                    .hint(format!("if you meant {}, write `{other}`", what(eqs.probe(other)))),
+                    .hint(format!(
+                        "if you meant {}, write `{other}`",
+                        what(eqs.probe(other))
+                    )),
             );
         }
         outputs.push(Output {
@@ -1418,7 +1430,10 @@ impl Model {
         let s = &self.settings;
         for ev in &self.source.events {
             let when = if ev.t < s.t_start {
-                format!("before t_start = {} s: it is applied at the start", s.t_start)
+                format!(
+                    "before t_start = {} s: it is applied at the start",
+                    s.t_start
+                )
             } else if ev.t > s.t_end {
                 format!("after t_end = {} s: it is not reached", s.t_end)
             } else {

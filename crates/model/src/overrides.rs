@@ -183,8 +183,17 @@ fn set_path(item: &mut Item, path: &[Segment], i: usize, value: Value) -> Result
             .unwrap_or(0);
         if k >= len {
             return Err((
-                format!("`{}` has {len} entries, so there is no `{}`", seg.key, seg.literal()),
-                Some(format!("entries are numbered from 0: {}[0] to {}[{}]", seg.key, seg.key, len.saturating_sub(1))),
+                format!(
+                    "`{}` has {len} entries, so there is no `{}`",
+                    seg.key,
+                    seg.literal()
+                ),
+                Some(format!(
+                    "entries are numbered from 0: {}[0] to {}[{}]",
+                    seg.key,
+                    seg.key,
+                    len.saturating_sub(1)
+                )),
             ));
         }
         if i + 1 == path.len() {
