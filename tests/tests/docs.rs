@@ -39,9 +39,9 @@ fn model_format_examples_load_and_run() {
             let name = format!("{doc} block {}", i + 1);
             let mut model = bg_model::Model::from_text(&name, &block, &bg_sim::registry(), &[])
                 .unwrap_or_else(|e| panic!("{e}"));
-            let out = model.run().unwrap();
+            let (out, checks) = model.run_checked().unwrap();
             assert!(out.error.is_none(), "{name}: {:?}", out.error);
-            for c in model.verify(&out.trajectory) {
+            for c in checks {
                 assert!(
                     c.passed,
                     "{name}: check {} failed: {:e}",

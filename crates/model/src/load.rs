@@ -1276,7 +1276,8 @@ pub fn valid_column_name(n: &str) -> bool {
 }
 
 /// `[outputs]` as columns (every state if the section is absent), and notes on outputs that
-/// likely meant another variable (`hose.P`, the power, next to `hose.p`, the pressure).
+/// likely meant another variable: `p_hose = "hose.P"` reads the power, next to `hose.p`, the
+/// pressure (a column whose name starts with `P` or says `power` is taken to mean a power).
 fn read_outputs(
     spec: &SpannedMap<String>,
     source: &Source,
@@ -1318,10 +1319,15 @@ fn read_outputs(
                 format!("`{}` offers: {}", clip(el), offers.join(", "))
             })
         })?;
-        if let Some(other) = names
+        // A power read into a column whose name does not say so (or the reverse), where a
+        // variable differing only in case exists: likely the other was meant.
+        let col_says_power =
+            col.get_ref().starts_with('P') || col.get_ref().to_ascii_lowercase().contains("power");
+        let is_power = matches!(probe, bondgraph::Probe::Power(_));
+        let other = names
             .iter()
-            .find(|n| *n != name.get_ref() && n.eq_ignore_ascii_case(name.get_ref()))
-        {
+            .find(|n| *n != name.get_ref() && n.eq_ignore_ascii_case(name.get_ref()));
+        if let Some(other) = other.filter(|_| col_says_power != is_power) {
             let what = |p: Option<bondgraph::Probe>| match p {
                 Some(bondgraph::Probe::State(_)) => "a state",
                 Some(bondgraph::Probe::Derivative(_)) => "a state's derivative",

@@ -1475,6 +1475,18 @@ fn an_output_differing_only_in_case_from_another_variable_gets_a_note() {
         "{n}"
     );
     assert!(load(MSD).unwrap().notes().is_empty());
+    // a column that says it is a power, or a momentum in a column that does not: no note
+    for fine in [
+        "P_mass = \"mass.P\"",
+        "mass_power = \"mass.P\"",
+        "x = \"mass.p\"",
+    ] {
+        let m = load(&msd_replacing("x = ", fine)).unwrap();
+        assert!(m.notes().is_empty(), "{fine}: {:?}", m.notes());
+    }
+    // the momentum read into a column named as a power
+    let m = load(&msd_replacing("x = ", "P_mass = \"mass.p\"")).unwrap();
+    assert_eq!(m.notes().len(), 1);
 }
 
 /// #4: events before t_start were applied at t_start and events after t_end dropped, silently.
