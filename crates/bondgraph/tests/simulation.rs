@@ -484,8 +484,12 @@ fn a_model_without_states_gives_its_outputs_at_the_output_times() {
         );
         assert!(run.error.is_none(), "{method:?}: {:?}", run.error);
         assert_eq!(col(&run.trajectory, "t"), [0.0, 0.25, 0.5, 0.75, 1.0]);
-        assert!(col(&run.trajectory, "r.f").iter().all(|f| *f == 0.5));
-        assert!(col(&run.trajectory, "r.P").iter().all(|p| *p == 1.0));
+        assert!(col(&run.trajectory, "r.f")
+            .iter()
+            .all(|f| (*f - 0.5).abs() < 1e-15));
+        assert!(col(&run.trajectory, "r.P")
+            .iter()
+            .all(|p| (*p - 1.0).abs() < 1e-15));
         assert_eq!(run.rows, 5);
     }
 }

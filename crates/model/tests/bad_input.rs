@@ -1533,6 +1533,7 @@ fn tolerances_and_times_beyond_f64_resolution_are_refused() {
 
 /// #10: `[initial]` keys with dots could not be set by `--set`.
 #[test]
+#[allow(clippy::float_cmp)] // values copied from the file: exact
 fn initial_keys_with_dots_can_be_set() {
     let text = msd_plus("[initial]\n\"spring.q\" = 0.02\n");
     let q = |m: &Model| {
@@ -1561,6 +1562,7 @@ fn initial_keys_with_dots_can_be_set() {
 /// #10: list entries (`events[0].t`) could not be addressed, and the error pointed at a line
 /// the user never wrote (a new `[events[0]]` table at the end of the file).
 #[test]
+#[allow(clippy::float_cmp)] // values copied from the file: exact
 fn list_entries_can_be_set_and_unknown_keys_are_refused_at_the_set() {
     let text = msd_plus("[[events]]\nt = 0.5\nset = { c = 0.0 }\n\n[[check]]\nvalue = \"x\"\nexpected = \"0\"\ntol = 1.0\n");
     let m = load_with(
