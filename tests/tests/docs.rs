@@ -53,3 +53,16 @@ fn model_format_examples_load_and_run() {
     }
     assert!(n >= 4, "found only {n} examples");
 }
+
+/// Issue "hardening" #10: `parameters.modes1 = 11` was accepted although the docs said 0–10;
+/// the bound of `manipulator.planar_arm` is 64, and the docs now say so.
+#[test]
+fn the_documented_range_of_modes_is_the_enforced_one() {
+    for doc in ["docs/knuckle-boom.md", "models/knuckle_boom.toml"] {
+        let text = std::fs::read_to_string(root().join(doc)).unwrap();
+        assert!(text.contains("0–64"), "{doc}");
+        assert!(!text.contains("(0–10;") && !text.contains("link 0–10 "), "{doc}");
+    }
+    let e = bg_tests::load("knuckle_boom", &["parameters.modes1=65"]).unwrap_err();
+    assert!(e.to_string().contains("0..=64"), "{e}");
+}

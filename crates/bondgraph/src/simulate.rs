@@ -14,6 +14,11 @@
 //! * After every accepted step the state is checked: a NaN or infinity stops the run with the
 //!   time, the state and its element named, and keeps the rows computed so far. A solver
 //!   failure does the same.
+//! * Rows go to a [`RowSink`] as they are computed ([`simulate_into`]; a file, in `bg-sim
+//!   run`), or are kept in memory ([`simulate`], bounded by [`MAX_VALUES_IN_MEMORY`]). A sink
+//!   may also ask for the outputs at every accepted step (checks that must hold between
+//!   rows). A refused row or [`Settings::interrupt`] stops the run after the current step.
+//! * A model with no states is not integrated: its rows are its outputs at the output times.
 
 use std::cell::{Cell, RefCell};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -519,6 +524,9 @@ struct Recorder<'e> {
     sink: &'e mut dyn RowSink,
     interrupt: Option<&'e AtomicBool>,
     wants_steps: bool,
+    /// The segment ends at an event: its last step is handed on after the switch (as the
+    /// output row at an event time is), not before.
+    event_at: Option<f64>,
     buf: Vec<f64>,
     p: Progress,
 }
@@ -552,11 +560,15 @@ impl Recorder<'_> {
     /// must stop (a refused row, or the interruption flag).
     fn accepted(&mut self, t: f64, x: &[f64]) -> Result<(), SimulationError> {
         watch(&mut self.p.watchers, t, x);
-        if self.wants_steps {
-            self.values(t, x);
-            self.sink.step(&self.buf);
+        if self.wants_steps && !self.event_at.is_some_and(|te| same_time(te, t)) {
+            self.step_values(t, x);
         }
         self.should_stop(t)
+    }
+    /// Hand the outputs at (t, x) to the sink as a step.
+    fn step_values(&mut self, t: f64, x: &[f64]) {
+        self.values(t, x);
+        self.sink.step(&self.buf);
     }
     fn should_stop(&mut self, t: f64) -> Result<(), SimulationError> {
         if let Some(e) = self.p.stop.take() {
@@ -712,7 +724,9 @@ pub fn simulate_into(
     watch(&mut progress.watchers, t0, x0);
     loop {
         // Apply every event due now.
+        let mut switched = false;
         while let Some(ev) = events.next_if(|e| e.t <= t || same_time(e.t, t)) {
+            switched = true;
             // All or nothing: check every replacement before applying any.
             let refused = ev
                 .replacements
@@ -732,6 +746,7 @@ pub fn simulate_into(
         if out.error.is_some() {
             break;
         }
+        let t_stop = events.peek().map_or(t_end, |e| e.t.min(t_end));
         let mut rec = Recorder {
             eqs,
             outputs,
@@ -739,14 +754,18 @@ pub fn simulate_into(
             sink: &mut *sink,
             interrupt,
             wants_steps,
+            event_at: (t_stop < t_end).then_some(t_stop),
             buf: std::mem::take(&mut buf),
             p: progress,
         };
+        // The step that reached an event time, after the switch.
+        if switched && wants_steps && t > t0 {
+            rec.step_values(t, &x);
+        }
         // Rows due at the current time (after the events).
         while rec.pending().is_some_and(|g| same_time(g, t)) {
             rec.record(t, &x);
         }
-        let t_stop = events.peek().map_or(t_end, |e| e.t.min(t_end));
         let seg = if t >= t_end || same_time(t, t_end) {
             None
         } else if x.is_empty() {
