@@ -261,7 +261,8 @@ fn overrides() -> impl Strategy<Value = Vec<String>> {
         prop::sample::select(EXTREMES).prop_map(str::to_owned),
         expression(),
     ];
-    prop::collection::vec((key, value).prop_map(|(k, v)| format!("{k}={v}")), 0..3)
+    let one = (key, value).prop_map(|(k, v)| format!("{k}={v}"));
+    prop_oneof![3 => Just(Vec::new()), 1 => prop::collection::vec(one, 1..3)]
 }
 
 fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
@@ -298,7 +299,7 @@ fn fuzz_model_loader() {
     let registry = bg_sim::registry();
     let strategy = (
         0..corpus.len(),
-        prop::collection::vec(mutation(), 1..=4),
+        prop::collection::vec(mutation(), 1..=3),
         overrides(),
     );
     let start = Instant::now();
