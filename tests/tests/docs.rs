@@ -61,7 +61,10 @@ fn the_documented_range_of_modes_is_the_enforced_one() {
     for doc in ["docs/knuckle-boom.md", "models/knuckle_boom.toml"] {
         let text = std::fs::read_to_string(root().join(doc)).unwrap();
         assert!(text.contains("0–64"), "{doc}");
-        assert!(!text.contains("(0–10;") && !text.contains("link 0–10 "), "{doc}");
+        assert!(
+            !text.contains("(0–10;") && !text.contains("link 0–10 "),
+            "{doc}"
+        );
     }
     let e = bg_tests::load("knuckle_boom", &["parameters.modes1=65"]).unwrap_err();
     assert!(e.to_string().contains("0..=64"), "{e}");

@@ -67,10 +67,55 @@ const EXTREMES: &[&str] = &[
 
 /// Tokens of TOML and of expressions, to insert anywhere.
 const TOKENS: &[&str] = &[
-    "\"", "'", "=", "[", "]", "[[", "]]", "{", "}", ".", ",", "->", "#", "\n", "(", ")", "^", "/",
-    "*", "-", "+", "\\", "\u{0}", "é", "\u{feff}", "\r\n", "clamp(", "min(", "sqrt(", "t", "pi",
-    "kind", "\"I\"", "\"1\"", "\"0\"", "[initial]", "[[events]]", "[outputs]", "[[check]]",
-    "[simulation]", "t_end", "dt_out", "rtol", "x.y", "a[1]", "\"a,b\"", "e", "1e", "..",
+    "\"",
+    "'",
+    "=",
+    "[",
+    "]",
+    "[[",
+    "]]",
+    "{",
+    "}",
+    ".",
+    ",",
+    "->",
+    "#",
+    "\n",
+    "(",
+    ")",
+    "^",
+    "/",
+    "*",
+    "-",
+    "+",
+    "\\",
+    "\u{0}",
+    "é",
+    "\u{feff}",
+    "\r\n",
+    "clamp(",
+    "min(",
+    "sqrt(",
+    "t",
+    "pi",
+    "kind",
+    "\"I\"",
+    "\"1\"",
+    "\"0\"",
+    "[initial]",
+    "[[events]]",
+    "[outputs]",
+    "[[check]]",
+    "[simulation]",
+    "t_end",
+    "dt_out",
+    "rtol",
+    "x.y",
+    "a[1]",
+    "\"a,b\"",
+    "e",
+    "1e",
+    "..",
 ];
 
 /// A generated expression: names, numbers, operators, calls, deep nesting and long chains.
@@ -85,7 +130,11 @@ fn expression() -> impl Strategy<Value = String> {
     ];
     let tree = leaf.prop_recursive(6, 64, 4, |inner| {
         prop_oneof![
-            (inner.clone(), prop::sample::select(vec!["+", "-", "*", "/", "^", " ", ","]), inner.clone())
+            (
+                inner.clone(),
+                prop::sample::select(vec!["+", "-", "*", "/", "^", " ", ","]),
+                inner.clone()
+            )
                 .prop_map(|(a, op, b)| format!("{a}{op}{b}")),
             inner.clone().prop_map(|a| format!("({a})")),
             inner.clone().prop_map(|a| format!("-{a}")),
@@ -99,7 +148,10 @@ fn expression() -> impl Strategy<Value = String> {
         ]
     });
     // extremes of depth and length around the limits (200 levels, 10 000 characters)
-    let extreme = (1usize..400, prop::sample::select(vec!["(", "-", "+", "sqrt(", "1+", "2^", "min(1,"]))
+    let extreme = (
+        1usize..400,
+        prop::sample::select(vec!["(", "-", "+", "sqrt(", "1+", "2^", "min(1,"]),
+    )
         .prop_map(|(n, open)| {
             let close = if open.ends_with('(') { ")" } else { "" };
             format!("{}1{}", open.repeat(n), close.repeat(n))
@@ -158,7 +210,8 @@ fn spans(text: &str, strings: bool) -> Vec<std::ops::Range<usize>> {
             continue;
         }
         let starts = b[i].is_ascii_digit()
-            && (i == 0 || !(b[i - 1].is_ascii_alphanumeric() || b[i - 1] == b'_' || b[i - 1] == b'.'));
+            && (i == 0
+                || !(b[i - 1].is_ascii_alphanumeric() || b[i - 1] == b'_' || b[i - 1] == b'.'));
         if !starts {
             i += 1;
             continue;
@@ -175,7 +228,9 @@ fn spans(text: &str, strings: bool) -> Vec<std::ops::Range<usize>> {
 
 fn char_index(text: &str, i: usize) -> usize {
     let n = text.chars().count().max(1);
-    text.char_indices().nth(i % n).map_or(text.len(), |(b, _)| b)
+    text.char_indices()
+        .nth(i % n)
+        .map_or(text.len(), |(b, _)| b)
 }
 
 fn apply(text: &str, m: &Mutation) -> String {
@@ -334,7 +389,10 @@ fn fuzz_model_loader() {
 /// The expression parser and evaluator over generated and mutated expressions.
 #[test]
 fn fuzz_expression_parser() {
-    let strategy = (expression(), prop::collection::vec((any::<usize>(), prop::sample::select(TOKENS)), 0..3));
+    let strategy = (
+        expression(),
+        prop::collection::vec((any::<usize>(), prop::sample::select(TOKENS)), 0..3),
+    );
     let start = Instant::now();
     let result = runner().run(&strategy, |(e, inserts)| {
         let mut s = e;
@@ -346,7 +404,10 @@ fn fuzz_expression_parser() {
             if let Ok(x) = Expr::parse(&s) {
                 let _ = x.names();
                 let _ = x.eval(&|n| (n.len() < 3).then_some(1.5));
-                if let Ok(c) = x.compile(&|n| (n == "k").then_some(2.0), &["t".into(), "mass.p".into()]) {
+                if let Ok(c) = x.compile(
+                    &|n| (n == "k").then_some(2.0),
+                    &["t".into(), "mass.p".into()],
+                ) {
                     let _ = c.eval(&[0.5, -1.0]);
                     let _ = c.constant();
                 }
