@@ -39,9 +39,9 @@ fn model_format_examples_load_and_run() {
             let name = format!("{doc} block {}", i + 1);
             let mut model = bg_model::Model::from_text(&name, &block, &bg_sim::registry(), &[])
                 .unwrap_or_else(|e| panic!("{e}"));
-            let out = model.run().unwrap();
+            let (out, checks) = model.run_checked().unwrap();
             assert!(out.error.is_none(), "{name}: {:?}", out.error);
-            for c in model.verify(&out.trajectory) {
+            for c in checks {
                 assert!(
                     c.passed,
                     "{name}: check {} failed: {:e}",
@@ -52,4 +52,20 @@ fn model_format_examples_load_and_run() {
         }
     }
     assert!(n >= 4, "found only {n} examples");
+}
+
+/// Issue "hardening" #10: `parameters.modes1 = 11` was accepted although the docs said 0–10;
+/// the bound of `manipulator.planar_arm` is 64, and the docs now say so.
+#[test]
+fn the_documented_range_of_modes_is_the_enforced_one() {
+    for doc in ["docs/knuckle-boom.md", "models/knuckle_boom.toml"] {
+        let text = std::fs::read_to_string(root().join(doc)).unwrap();
+        assert!(text.contains("0–64"), "{doc}");
+        assert!(
+            !text.contains("(0–10;") && !text.contains("link 0–10 "),
+            "{doc}"
+        );
+    }
+    let e = bg_tests::load("knuckle_boom", &["parameters.modes1=65"]).unwrap_err();
+    assert!(e.to_string().contains("0..=64"), "{e}");
 }

@@ -13,9 +13,9 @@ fn every_model_runs_and_passes_its_checks() {
     for path in model_files().into_iter().filter(|p| !is_refused(p)) {
         let mut model = bg_model::Model::load(&path, &bg_sim::registry(), &[])
             .unwrap_or_else(|e| panic!("{e}"));
-        let out = model.run().unwrap();
+        // checks at every accepted step, not only at the output rows
+        let (out, checks) = model.run_checked().unwrap();
         assert!(out.error.is_none(), "{}: {:?}", path.display(), out.error);
-        let checks = model.verify(&out.trajectory);
         assert!(
             !checks.is_empty(),
             "{} has no [[check]]: every example carries its expected result",
@@ -127,6 +127,6 @@ fn set_overrides_change_the_run() {
         (a.parameters["w_ss"] - b.parameters["w_ss"] / 2.0).abs() < 1e-9,
         "w_ss follows V"
     );
-    let out = a.run().unwrap();
-    assert!(a.verify(&out.trajectory).iter().all(|c| c.passed));
+    let (_, checks) = a.run_checked().unwrap();
+    assert!(checks.iter().all(|c| c.passed && c.every_step));
 }

@@ -1,15 +1,48 @@
 //! `bg-sim`: run and check bond-graph model files. No physics lives here: the CLI loads a
 //! model through `bg-model`, runs it through `bondgraph`, and writes the results.
 
+use std::fs::File;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::atomic::AtomicBool;
+use std::sync::{Arc, Mutex};
 
 use bg_model::{inspect, Model};
 use bg_sim::plot::{plot_all, work_precision, Drawn, Results, WorkPrecisionLine};
 use bg_sim::registry;
-use bondgraph::{Method, Outcome};
+use bondgraph::{Method, RowSink, SimulationError};
 use clap::{Parser, Subcommand};
+
+/// The first error writing to stdout (a closed pipe, a full disk). The report is lost, not
+/// the run: the CSV is still written and the checks still decide the exit status.
+static STDOUT_ERROR: Mutex<Option<std::io::ErrorKind>> = Mutex::new(None);
+
+/// Write one line to stdout (`to_stderr`: stderr) without ever panicking.
+fn emit(to_stderr: bool, args: std::fmt::Arguments<'_>) {
+    let written = if to_stderr {
+        let mut e = std::io::stderr().lock();
+        e.write_fmt(args).and_then(|()| e.write_all(b"\n"))
+    } else {
+        let mut o = std::io::stdout().lock();
+        o.write_fmt(args).and_then(|()| o.write_all(b"\n"))
+    };
+    if let (Err(e), false) = (written, to_stderr) {
+        if let Ok(mut first) = STDOUT_ERROR.lock() {
+            first.get_or_insert(e.kind());
+        }
+    }
+}
+
+/// `println!` that never panics.
+macro_rules! say {
+    ($($arg:tt)*) => { emit(false, format_args!($($arg)*)) };
+}
+
+/// `eprintln!` that never panics.
+macro_rules! tell {
+    ($($arg:tt)*) => { emit(true, format_args!($($arg)*)) };
+}
 
 #[derive(Parser)]
 #[command(
@@ -133,9 +166,35 @@ enum Command {
     },
 }
 
+/// Exit statuses (README, "Exit status").
+const BAD_INPUT: u8 = 2;
+const FAILED: u8 = 1;
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    match cli.command {
+    // For these commands the report on stdout is the product: losing it is a failure.
+    let stdout_is_product = matches!(
+        cli.command,
+        Command::Kinds | Command::Check { .. } | Command::Compare { .. }
+    );
+    let code = dispatch(cli.command);
+    let lost = STDOUT_ERROR.lock().ok().and_then(|e| *e);
+    match lost {
+        // the reader went away (`| head`): what it read is what it wanted
+        None | Some(std::io::ErrorKind::BrokenPipe) => code,
+        Some(kind) => {
+            tell!("warning: the report on stdout is incomplete: {kind}");
+            if stdout_is_product && code == ExitCode::SUCCESS {
+                ExitCode::from(FAILED)
+            } else {
+                code
+            }
+        }
+    }
+}
+
+fn dispatch(command: Command) -> ExitCode {
+    match command {
         Command::Run {
             model,
             output,
@@ -170,7 +229,7 @@ fn main() -> ExitCode {
         Command::Check { model, set } => check(&model, &set),
         Command::Kinds => {
             for (k, info) in registry().kinds() {
-                println!("{k:<24} {}", info.summary);
+                say!("{k:<24} {}", info.summary);
             }
             ExitCode::SUCCESS
         }
@@ -231,13 +290,13 @@ fn bench(a: &BenchArgs<'_>) -> ExitCode {
     let mut model = match Model::load(a.path, &registry(), a.set) {
         Ok(m) => m,
         Err(e) => {
-            eprintln!("error: {e}");
+            tell!("error: {e}");
             return ExitCode::from(2);
         }
     };
     if a.rhs_only {
         let c = rhs_cost(&model, 20_000);
-        println!(
+        say!(
             "{}: {} states; rhs {:.3} µs per call, Jacobian {:.3} µs per call ({:.1} rhs-equivalents; medians of 7 samples)",
             model.file(),
             c.n,
@@ -252,7 +311,7 @@ fn bench(a: &BenchArgs<'_>) -> ExitCode {
         match Method::parse(s) {
             Some(m) => methods.push(m),
             None => {
-                eprintln!(
+                tell!(
                     "error: unknown solver `{s}`\n  hint: solvers are {}",
                     Method::names()
                 );
@@ -270,7 +329,7 @@ fn bench(a: &BenchArgs<'_>) -> ExitCode {
                 floors.push((p.to_owned(), v));
             }
             _ => {
-                eprintln!("error: --floor `{f}`: expected PATTERN=VALUE with a finite VALUE ≥ 0\n  hint: --floor 'qb*=1e-3'");
+                tell!("error: --floor `{f}`: expected PATTERN=VALUE with a finite VALUE ≥ 0\n  hint: --floor 'qb*=1e-3'");
                 return ExitCode::from(2);
             }
         }
@@ -281,7 +340,7 @@ fn bench(a: &BenchArgs<'_>) -> ExitCode {
     for &r in a.rtols.iter().chain(std::iter::once(&a.reference_rtol)) {
         model.settings.rtol = r;
         if let Err(e) = model.settings.validate() {
-            eprintln!("error: {e}");
+            tell!("error: {e}");
             return ExitCode::from(2);
         }
     }
@@ -304,11 +363,11 @@ fn bench(a: &BenchArgs<'_>) -> ExitCode {
     let (what, reference) = match reference {
         Ok(r) => r,
         Err(e) => {
-            eprintln!("error: {e}");
+            tell!("error: {e}");
             return ExitCode::from(2);
         }
     };
-    println!(
+    say!(
         "{}: {} states, 0 → {} s; reference {what}; {} columns scored",
         model.file(),
         model.equations.n_states(),
@@ -317,7 +376,7 @@ fn bench(a: &BenchArgs<'_>) -> ExitCode {
     );
     match bench(&mut model, &methods, a.rtols, &reference, a.repeat) {
         Ok(rows) => {
-            print!("{}", table(&rows));
+            say!("{}", table(&rows).trim_end_matches('\n'));
             if let Some(png) = a.plot {
                 let lines: Vec<WorkPrecisionLine> = methods
                     .iter()
@@ -339,9 +398,9 @@ fn bench(a: &BenchArgs<'_>) -> ExitCode {
                     model.title.as_deref().unwrap_or(model.file())
                 );
                 match work_precision(&title, &lines, png) {
-                    Ok(p) => println!("wrote {}", p.display()),
+                    Ok(p) => say!("wrote {}", p.display()),
                     Err(e) => {
-                        eprintln!("error: {e}");
+                        tell!("error: {e}");
                         return ExitCode::from(1);
                     }
                 }
@@ -349,7 +408,7 @@ fn bench(a: &BenchArgs<'_>) -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            tell!("error: {e}");
             ExitCode::from(1)
         }
     }
@@ -367,7 +426,7 @@ fn parse_floors(args: &[String]) -> Option<Vec<(String, f64)>> {
                 floors.push((p.to_owned(), v));
             }
             _ => {
-                eprintln!("error: --floor `{f}`: expected PATTERN=VALUE with a finite VALUE ≥ 0\n  hint: --floor 'qb*=1e-3'");
+                tell!("error: --floor `{f}`: expected PATTERN=VALUE with a finite VALUE ≥ 0\n  hint: --floor 'qb*=1e-3'");
                 return None;
             }
         }
@@ -399,17 +458,17 @@ fn compare(
     });
     match scored {
         Ok((r, errors)) => {
-            println!("| column | scale | scaled error |\n|---|---|---|");
+            say!("| column | scale | scaled error |\n|---|---|---|");
             for ((name, e), (_, _, scale)) in errors.iter().zip(&r.columns) {
-                println!("| {name} | {scale:.4e} | {e:.3e} |");
+                say!("| {name} | {scale:.4e} | {e:.3e} |");
             }
             if let Some((name, e)) = errors.iter().max_by(|a, b| a.1.total_cmp(&b.1)) {
-                println!("worst: {name} {e:.3e}");
+                say!("worst: {name} {e:.3e}");
             }
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            tell!("error: {e}");
             ExitCode::from(2)
         }
     }
@@ -425,18 +484,18 @@ fn plot(results: &Path, dir: &Path, quiet: bool) -> ExitCode {
                     Drawn::Written(p) => {
                         written += 1;
                         if !quiet {
-                            println!("wrote {}", p.display());
+                            say!("wrote {}", p.display());
                         }
                     }
                     Drawn::Skipped { file, missing } => {
                         if !quiet {
-                            println!("skipped {file}: no column {}", missing.join(", "));
+                            say!("skipped {file}: no column {}", missing.join(", "));
                         }
                     }
                 }
             }
             if written == 0 {
-                eprintln!(
+                tell!(
                     "error: {} has none of the columns of the figures (t, q1, l1, p_p1, F_c1, rho1, …)",
                     results.display()
                 );
@@ -445,7 +504,7 @@ fn plot(results: &Path, dir: &Path, quiet: bool) -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            tell!("error: {e}");
             ExitCode::from(2)
         }
     }
@@ -463,22 +522,22 @@ fn run(
     set: &[String],
     quiet: bool,
 ) -> (ExitCode, Option<PathBuf>) {
+    let refuse = |m: String| {
+        tell!("error: {m}");
+        (ExitCode::from(BAD_INPUT), None)
+    };
     let mut model = match Model::load(path, &registry(), set) {
         Ok(m) => m,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return (ExitCode::from(2), None);
-        }
+        Err(e) => return refuse(e.to_string()),
     };
     if let Some(s) = solver {
         match Method::parse(s) {
             Some(m) => model.settings.method = m,
             None => {
-                eprintln!(
-                    "error: unknown solver `{s}`\n  hint: solvers are {}",
+                return refuse(format!(
+                    "unknown solver `{s}`\n  hint: solvers are {}",
                     Method::names()
-                );
-                return (ExitCode::from(2), None);
+                ))
             }
         }
     }
@@ -495,8 +554,7 @@ fn run(
         model.settings.dt_out = v;
     }
     if let Err(e) = model.settings.validate() {
-        eprintln!("error: {e}");
-        return (ExitCode::from(2), None);
+        return refuse(e.to_string());
     }
     let out_path = output.unwrap_or_else(|| {
         let stem = path
@@ -504,9 +562,15 @@ fn run(
             .map_or_else(|| "model".into(), |s| s.to_string_lossy().into_owned());
         PathBuf::from("out").join(format!("{stem}.csv"))
     });
+    let partial = partial_path(&out_path);
+    // Before any work: the destination must be writable and must not be the model itself.
+    let mut sink = match open_output(&out_path, &partial, path, &model) {
+        Ok(s) => s,
+        Err(m) => return refuse(m),
+    };
     if !quiet {
         let s = &model.settings;
-        println!(
+        say!(
             "{}: {} states, {} → {} s, {} (rtol {:e}, atol {:e}), output every {} s",
             model.title.as_deref().unwrap_or(model.file()),
             model.equations.n_states(),
@@ -517,69 +581,121 @@ fn run(
             s.atol,
             s.dt_out
         );
+        for n in model.notes() {
+            tell!("note: {n}");
+        }
     }
-    let outcome = match model.run() {
-        Ok(o) => o,
+    model.settings.interrupt = Some(interrupt_on_signals());
+    let (outcome, checks) = match model.run_into(&mut sink) {
+        Ok(r) => r,
         Err(e) => {
-            eprintln!("error: {e}");
-            return (ExitCode::from(2), None);
+            let _ = std::fs::remove_file(&partial);
+            return refuse(e.to_string());
         }
     };
-    let complete = outcome.error.is_none();
-    let target = if complete {
+    // The rows still buffered; a failure here (a full disk) makes the run incomplete.
+    let flushed = sink.flush();
+    let error = match (&outcome.error, &flushed) {
+        (Some(e), _) => Some(e.to_string()),
+        (None, Err(e)) => Some(
+            SimulationError::Output {
+                t: outcome.t_final,
+                message: e.to_string(),
+            }
+            .to_string(),
+        ),
+        (None, Ok(())) => None,
+    };
+    let target = if error.is_none() {
+        // complete: the rows become OUT.csv in one rename (a reader never sees half a file),
+        // and no partial file is left beside it
+        if let Err(e) = std::fs::rename(&partial, &out_path) {
+            return refuse(format!(
+                "cannot rename {} to {}: {e} (the complete results are in {})",
+                partial.display(),
+                out_path.display(),
+                partial.display()
+            ));
+        }
         out_path.clone()
     } else {
-        partial_path(&out_path)
+        partial.clone()
     };
-    if let Err(e) = write_csv(&target, &outcome) {
-        eprintln!("error: cannot write {}: {e}", target.display());
-        return (ExitCode::from(2), None);
-    }
     if !quiet {
-        println!("solver: {}", outcome.stats);
-        println!(
+        say!("solver: {}", outcome.stats);
+        say!(
             "wrote {} rows × {} columns to {}",
-            outcome.trajectory.rows.len(),
+            sink.rows,
             outcome.trajectory.columns.len(),
             target.display()
         );
     }
     for w in &outcome.watched {
         if let Some(warning) = &w.warning {
-            eprintln!("warning: {warning}");
+            tell!("warning: {warning}");
         } else if !quiet {
-            println!(
+            say!(
                 "minimum {} of {}: {:.6e} at t = {:.6} s",
-                w.name, w.element, w.min, w.t_min
+                w.name,
+                w.element,
+                w.min,
+                w.t_min
             );
         }
     }
     let mut code = ExitCode::SUCCESS;
-    if let Some(e) = &outcome.error {
-        eprintln!("error: {}: the run stopped early: {e}", model.file());
-        eprintln!(
-            "  the {} rows computed up to t = {} s are in {} ({} was not written)",
-            outcome.trajectory.rows.len(),
-            outcome.t_final,
-            target.display(),
-            out_path.display()
-        );
-        code = ExitCode::from(1);
+    if let Some(e) = &error {
+        tell!("error: {}: the run stopped early: {e}", model.file());
+        match sink.last_t {
+            Some(t) => tell!(
+                "  the {} rows computed up to t = {t} s are in {} ({} was not written)",
+                sink.rows,
+                partial.display(),
+                out_path.display()
+            ),
+            None => tell!(
+                "  no row was computed: {} holds the header only ({} was not written)",
+                partial.display(),
+                out_path.display()
+            ),
+        }
+        code = ExitCode::from(FAILED);
     } else {
-        for r in model.verify(&outcome.trajectory) {
+        for r in checks {
             let status = if r.passed { "ok  " } else { "FAIL" };
             if !quiet || !r.passed {
-                println!(
-                    "check {status} {}: max |error| {:.3e} at t = {:.6} (tolerance {:.1e})",
-                    r.value, r.max_error, r.t_worst, r.tol
+                say!(
+                    "check {status} {}: max |error| {:.3e} at t = {:.6} (tolerance {:.1e}; {} points: every accepted step and output row)",
+                    r.value,
+                    r.max_error,
+                    r.t_worst,
+                    r.tol,
+                    r.points
                 );
             }
             if !r.passed {
-                code = ExitCode::from(1);
+                code = ExitCode::from(FAILED);
             }
         }
     }
     (code, Some(target))
+}
+
+/// SIGINT and SIGTERM set the returned flag, which the run checks after every step: it stops
+/// and keeps its rows in `OUT.partial.csv`. A second signal ends the process at once (exit 1),
+/// leaving the rows written so far in `OUT.partial.csv`.
+fn interrupt_on_signals() -> Arc<AtomicBool> {
+    let flag = Arc::new(AtomicBool::new(false));
+    for sig in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+        // registration fails only for forbidden signals; without it, the default action stays
+        let _ = signal_hook::flag::register_conditional_shutdown(
+            sig,
+            i32::from(FAILED),
+            Arc::clone(&flag),
+        );
+        let _ = signal_hook::flag::register(sig, Arc::clone(&flag));
+    }
+    flag
 }
 
 fn partial_path(p: &Path) -> PathBuf {
@@ -589,64 +705,217 @@ fn partial_path(p: &Path) -> PathBuf {
     p.with_file_name(format!("{stem}.partial.csv"))
 }
 
-/// Write the CSV next to its destination, then rename: a reader never sees half a file.
-fn write_csv(path: &Path, outcome: &Outcome) -> std::io::Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    std::fs::create_dir_all(&dir)?;
-    let mut tmp = tempfile::NamedTempFile::new_in(&dir)?;
-    {
-        let mut w = std::io::BufWriter::new(tmp.as_file_mut());
-        writeln!(w, "{}", outcome.trajectory.columns.join(","))?;
-        for row in &outcome.trajectory.rows {
-            let mut first = true;
-            for v in row {
-                if !first {
-                    w.write_all(b",")?;
-                }
-                first = false;
-                write!(w, "{v}")?;
-            }
-            w.write_all(b"\n")?;
+/// Refuse to write over `p` unless it is absent or a regular file other than the model:
+/// `-o model.toml`, a symbolic link, a FIFO, a directory or a device are refused.
+fn check_destination(p: &Path, model: &Path) -> Result<(), String> {
+    if let Ok(m) = std::fs::symlink_metadata(p) {
+        let t = m.file_type();
+        let what = if t.is_symlink() {
+            Some("a symbolic link")
+        } else if t.is_dir() {
+            Some("a directory")
+        } else if !t.is_file() {
+            Some("not a regular file (a FIFO, socket or device)")
+        } else {
+            None
+        };
+        if let Some(what) = what {
+            return Err(format!(
+                "{} is {what}: bg-sim writes results only to regular files\n  hint: name a new or regular file with -o",
+                p.display()
+            ));
         }
-        w.flush()?;
     }
-    tmp.persist(path).map_err(|e| e.error)?;
+    if same_file(p, model) {
+        return Err(format!(
+            "{} is the model file: writing the results there would destroy it\n  hint: name another file with -o",
+            p.display()
+        ));
+    }
     Ok(())
+}
+
+/// Whether two paths name the same existing file.
+fn same_file(a: &Path, b: &Path) -> bool {
+    let (Ok(x), Ok(y)) = (std::fs::metadata(a), std::fs::metadata(b)) else {
+        return false;
+    };
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        x.dev() == y.dev() && x.ino() == y.ino()
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = (x, y);
+        matches!((a.canonicalize(), b.canonicalize()), (Ok(p), Ok(q)) if p == q)
+    }
+}
+
+/// Check both destinations, create `OUT.partial.csv` with the header, and remove an `OUT.csv`
+/// of an earlier run (so that `OUT.csv` and `OUT.partial.csv` never both exist after a run).
+fn open_output(
+    out: &Path,
+    partial: &Path,
+    model_path: &Path,
+    model: &Model,
+) -> Result<CsvSink, String> {
+    check_destination(out, model_path)?;
+    check_destination(partial, model_path)?;
+    let columns: Vec<&str> = std::iter::once("t")
+        .chain(model.outputs.iter().map(|o| o.name.as_str()))
+        .collect();
+    let cannot = |p: &Path, e: std::io::Error| format!("cannot write {}: {e}", p.display());
+    if let Some(dir) = partial.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| cannot(dir, e))?;
+    }
+    let sink = CsvSink::create(partial, &columns).map_err(|e| cannot(partial, e))?;
+    match std::fs::remove_file(out) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            Err(format!("cannot replace {}: {e}", out.display()))
+        }
+        _ => Ok(sink),
+    }
+}
+
+/// A CSV field: quoted (RFC 4180) if it holds a comma, a quote or a line break. The loader
+/// allows only plain column names; this keeps any other name from breaking the header.
+fn csv_field(s: &str) -> std::borrow::Cow<'_, str> {
+    if s.contains([',', '"', '\n', '\r']) || s.is_empty() {
+        format!("\"{}\"", s.replace('"', "\"\"")).into()
+    } else {
+        s.into()
+    }
+}
+
+/// Rows streamed to `OUT.partial.csv` as they are computed, in whole lines: rows are
+/// formatted into a buffer of complete lines and written 64 kB at a time. If a write fails
+/// (a full disk), the file is cut back to its last complete row and as many of the buffered
+/// rows as still fit are written one by one.
+struct CsvSink {
+    file: File,
+    buf: Vec<u8>,
+    /// Time of each buffered row.
+    buffered: Vec<f64>,
+    /// Bytes of complete lines in the file.
+    committed: u64,
+    /// Rows in the file.
+    rows: usize,
+    /// Time of the last row in the file.
+    last_t: Option<f64>,
+}
+
+impl CsvSink {
+    fn create(path: &Path, columns: &[&str]) -> std::io::Result<Self> {
+        let file = File::create(path)?;
+        let mut sink = Self {
+            file,
+            buf: Vec::with_capacity(1 << 17),
+            buffered: Vec::new(),
+            committed: 0,
+            rows: 0,
+            last_t: None,
+        };
+        let header: Vec<_> = columns.iter().map(|c| csv_field(c)).collect();
+        writeln!(sink.buf, "{}", header.join(","))?;
+        sink.flush()?;
+        Ok(sink)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        use std::io::{Seek, SeekFrom};
+        if self.buf.is_empty() {
+            return Ok(());
+        }
+        let buf = std::mem::take(&mut self.buf);
+        let times = std::mem::take(&mut self.buffered);
+        let r = self.file.write_all(&buf);
+        // lines before the rows: the header, in the first flush
+        let lines = buf.iter().filter(|b| **b == b'\n').count();
+        let header = lines.saturating_sub(times.len());
+        let mut t = times.iter().copied();
+        match r {
+            Ok(()) => {
+                self.committed += buf.len() as u64;
+                self.rows += times.len();
+                self.last_t = times.last().copied().or(self.last_t);
+            }
+            Err(ref _e) => {
+                // keep whole rows only, then as many of the buffered ones as fit
+                let _ = self.file.set_len(self.committed);
+                let _ = self.file.seek(SeekFrom::Start(self.committed));
+                for (k, line) in buf.split_inclusive(|b| *b == b'\n').enumerate() {
+                    if self.file.write_all(line).is_err() {
+                        let _ = self.file.set_len(self.committed);
+                        break;
+                    }
+                    self.committed += line.len() as u64;
+                    if k >= header {
+                        self.rows += 1;
+                        self.last_t = t.next().or(self.last_t);
+                    }
+                }
+            }
+        }
+        self.buf = buf;
+        self.buf.clear();
+        r
+    }
+}
+
+impl RowSink for CsvSink {
+    fn row(&mut self, row: &[f64]) -> Result<(), String> {
+        let mut first = true;
+        for v in row {
+            if !first {
+                self.buf.push(b',');
+            }
+            first = false;
+            // infallible: writing to a Vec
+            let _ = write!(self.buf, "{v}");
+        }
+        self.buf.push(b'\n');
+        self.buffered.push(row.first().copied().unwrap_or(f64::NAN));
+        if self.buf.len() >= 1 << 16 {
+            self.flush().map_err(|e| e.to_string())?;
+        }
+        Ok(())
+    }
 }
 
 fn check(path: &Path, set: &[String]) -> ExitCode {
     let report = inspect(path, &registry(), set);
     if !report.elements.is_empty() {
-        println!("elements ({}):", report.elements.len());
+        say!("elements ({}):", report.elements.len());
         for (name, kind, line) in &report.elements {
-            println!("  {name:<20} {kind:<20} line {line}");
+            say!("  {name:<20} {kind:<20} line {line}");
         }
     }
     if !report.bonds.is_empty() {
-        println!(
+        say!(
             "bonds ({}), `|` marks the causal stroke (the end that receives the effort):",
             report.bonds.len()
         );
         for b in &report.bonds {
-            println!("  {b}");
+            say!("  {b}");
         }
     }
     if !report.states.is_empty() {
-        println!("states ({}):", report.states.len());
+        say!("states ({}):", report.states.len());
         for (name, v) in &report.states {
-            println!("  {name:<24} initial {v}");
+            say!("  {name:<24} initial {v}");
         }
     }
+    for n in &report.notes {
+        say!("  note: {n}");
+    }
     if report.problems.is_empty() {
-        println!("no problems found");
+        say!("no problems found");
         ExitCode::SUCCESS
     } else {
-        println!("problems ({}):", report.problems.len());
+        say!("problems ({}):", report.problems.len());
         for p in &report.problems {
-            println!("  error: {p}");
+            say!("  error: {p}");
         }
         ExitCode::from(1)
     }

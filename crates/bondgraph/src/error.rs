@@ -293,6 +293,21 @@ pub enum SimulationError {
         /// The element's explanation.
         message: String,
     },
+    /// The run was interrupted ([`Settings::interrupt`](crate::Settings::interrupt): SIGINT,
+    /// SIGTERM) after the step that reached `t`.
+    #[error("interrupted at t = {t:.9} s")]
+    Interrupted {
+        /// Time reached.
+        t: f64,
+    },
+    /// The sink of the output rows refused one (a full disk, a closed file).
+    #[error("the output row at t = {t:.9} s could not be written: {message}")]
+    Output {
+        /// Time of the refused row.
+        t: f64,
+        /// Why.
+        message: String,
+    },
     /// A scheduled event could not be applied.
     #[error("event at t = {t} s: {source}")]
     Event {

@@ -74,5 +74,6 @@ pub use local_jacobian::{check_partials, LocalJacobian, LocalShape};
 pub use nalgebra::DMatrix;
 pub use radau::{OdeSystem, Radau5, RadauError, RadauOptions, RadauStats, StepReport};
 pub use simulate::{
-    simulate, Event, Method, Outcome, Output, Settings, Statistics, Trajectory, WatchReport,
+    check_in_memory, simulate, simulate_into, Event, Method, Outcome, Output, RowSink, Settings,
+    Statistics, Trajectory, WatchReport, MAX_OUTPUT_ROWS, MAX_VALUES_IN_MEMORY, MIN_RTOL,
 };

@@ -14,8 +14,15 @@
 //! * After every accepted step the state is checked: a NaN or infinity stops the run with the
 //!   time, the state and its element named, and keeps the rows computed so far. A solver
 //!   failure does the same.
+//! * Rows go to a [`RowSink`] as they are computed ([`simulate_into`]; a file, in `bg-sim
+//!   run`), or are kept in memory ([`simulate`], bounded by [`MAX_VALUES_IN_MEMORY`]). A sink
+//!   may also ask for the outputs at every accepted step (checks that must hold between
+//!   rows). A refused row or [`Settings::interrupt`] stops the run after the current step.
+//! * A model with no states is not integrated: its rows are its outputs at the output times.
 
 use std::cell::{Cell, RefCell};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use diffsol::{
@@ -104,6 +111,10 @@ pub struct Settings {
     pub atol: f64,
     /// Most accepted steps before the run is stopped (a stalled or far too stiff run).
     pub max_steps: usize,
+    /// Set it to `true` (a SIGINT/SIGTERM handler, another thread) to stop the run after the
+    /// current step: the rows so far are kept and the outcome's error is
+    /// [`SimulationError::Interrupted`].
+    pub interrupt: Option<Arc<AtomicBool>>,
 }
 
 impl Default for Settings {
@@ -116,8 +127,27 @@ impl Default for Settings {
             rtol: 1e-6,
             atol: 1e-8,
             max_steps: 10_000_000,
+            interrupt: None,
         }
     }
+}
+
+/// Most output rows a run may ask for (`(t_end − t_start)/dt_out`). Rows stream to their sink
+/// as they are computed ([`simulate_into`]), so the bound is a guard against a mistyped
+/// `dt_out`, not a memory limit.
+pub const MAX_OUTPUT_ROWS: f64 = 1e9;
+
+/// Most values (rows × columns, `t` included) a run that keeps its rows in memory
+/// ([`simulate`]) may hold: 5·10⁷ values are 400 MB.
+pub const MAX_VALUES_IN_MEMORY: f64 = 5e7;
+
+/// Smallest relative tolerance: below it the error test asks for more than f64 resolves.
+pub const MIN_RTOL: f64 = 1e-14;
+
+/// The solver's time resolution near `t_start`, `t_end`: a step shorter than this counts as a
+/// collapsed step size (see `drive`).
+fn time_resolution(s: &Settings) -> f64 {
+    1e-14 * s.t_start.abs().max(s.t_end.abs()).max(1.0)
 }
 
 impl Settings {
@@ -140,19 +170,55 @@ impl Settings {
                 format!("must be finite and > 0, got {}", self.dt_out),
             );
         }
-        if (self.t_end - self.t_start) / self.dt_out > 1e7 {
+        let res = time_resolution(self);
+        if self.t_end - self.t_start < 1e4 * res {
             return bad(
-                "dt_out",
-                format!("{} gives more than 1e7 output rows", self.dt_out),
+                "t_end",
+                format!(
+                    "t_end − t_start = {:e} s is too short to integrate at times near {:e} s, where f64 times are {:e} s apart and the shortest step is {res:e} s; it must be at least {:e} s (hint: start the time at 0)",
+                    self.t_end - self.t_start,
+                    self.t_start.abs().max(self.t_end.abs()),
+                    f64::EPSILON * self.t_start.abs().max(self.t_end.abs()),
+                    1e4 * res
+                ),
             );
         }
-        if !(self.rtol.is_finite() && self.rtol > 0.0 && self.rtol < 1.0) {
-            return bad("rtol", format!("must be in (0, 1), got {}", self.rtol));
+        if self.dt_out < res {
+            return bad(
+                "dt_out",
+                format!(
+                    "{:e} s is below the time resolution {res:e} s at these times",
+                    self.dt_out
+                ),
+            );
+        }
+        if (self.t_end - self.t_start) / self.dt_out > MAX_OUTPUT_ROWS {
+            return bad(
+                "dt_out",
+                format!(
+                    "{} gives {:.3e} output rows, more than {MAX_OUTPUT_ROWS:e}",
+                    self.dt_out,
+                    (self.t_end - self.t_start) / self.dt_out
+                ),
+            );
+        }
+        if !(self.rtol.is_finite() && (MIN_RTOL..1.0).contains(&self.rtol)) {
+            return bad(
+                "rtol",
+                format!("must be in [{MIN_RTOL:e}, 1), got {}", self.rtol),
+            );
         }
         if !(self.atol.is_finite() && self.atol > 0.0) {
             return bad("atol", format!("must be finite and > 0, got {}", self.atol));
         }
         Ok(())
+    }
+
+    /// The number of output rows: `t_start, t_start + dt_out, …` up to `t_end`, and `t_end`.
+    #[must_use]
+    pub fn output_rows(&self) -> f64 {
+        let n = ((self.t_end - self.t_start) / self.dt_out + 1e-9).floor();
+        n + 2.0
     }
 }
 
@@ -231,8 +297,10 @@ impl Trajectory {
 /// What a run produced: the rows so far, the statistics, and the error that stopped it, if any.
 #[derive(Debug)]
 pub struct Outcome {
-    /// Output rows computed.
+    /// The column names; the rows, when they are kept in memory ([`simulate`]).
     pub trajectory: Trajectory,
+    /// Output rows delivered (to the sink of [`simulate_into`], or kept in `trajectory`).
+    pub rows: usize,
     /// Solver work.
     pub stats: Statistics,
     /// Time reached.
@@ -389,26 +457,135 @@ pub struct Output {
     pub probe: Probe,
 }
 
+/// Where a run's output rows go, one at a time, as they are computed ([`simulate_into`]): a
+/// file, a check, a plot. `Vec<Vec<f64>>` is a sink that keeps them in memory.
+pub trait RowSink {
+    /// One output row: `t`, then the outputs in order. An error stops the run; the outcome's
+    /// error is then [`SimulationError::Output`] and the rows before this one were delivered.
+    fn row(&mut self, row: &[f64]) -> Result<(), String>;
+    /// Whether [`RowSink::step`] wants the outputs at every accepted solver step too.
+    fn wants_steps(&self) -> bool {
+        false
+    }
+    /// The outputs (`t` first) at an accepted solver step, between output rows: what a check
+    /// that must hold at every step reads. Called only if [`RowSink::wants_steps`].
+    fn step(&mut self, _values: &[f64]) {}
+}
+
+impl RowSink for Vec<Vec<f64>> {
+    fn row(&mut self, row: &[f64]) -> Result<(), String> {
+        self.push(row.to_vec());
+        Ok(())
+    }
+}
+
+/// The output times `t0, t0 + Δ, …`, and `t_end` if the grid misses it, without storing them.
+#[derive(Clone, Copy, Debug)]
+struct Grid {
+    t0: f64,
+    dt: f64,
+    /// Index of the last grid point `t0 + n·Δ` at or before `t_end`.
+    n: usize,
+    t_end: f64,
+    /// `t_end` is one more row (the grid does not land on it).
+    end_extra: bool,
+}
+
+impl Grid {
+    fn new(s: &Settings) -> Self {
+        let n = ((s.t_end - s.t_start) / s.dt_out + 1e-9).floor() as usize;
+        let last = s.t_start + n as f64 * s.dt_out;
+        Self {
+            t0: s.t_start,
+            dt: s.dt_out,
+            n,
+            t_end: s.t_end,
+            end_extra: !same_time(last, s.t_end),
+        }
+    }
+    fn at(&self, k: usize) -> Option<f64> {
+        if k <= self.n {
+            Some(self.t0 + k as f64 * self.dt)
+        } else if k == self.n + 1 && self.end_extra {
+            Some(self.t_end)
+        } else {
+            None
+        }
+    }
+}
+
+/// What the recorder carries from one segment to the next.
+struct Progress {
+    watchers: Vec<Watcher>,
+    /// Index of the next grid time.
+    next: usize,
+    /// Rows delivered to the sink.
+    rows: usize,
+    /// Why the run must stop at the next step: the sink refused a row.
+    stop: Option<SimulationError>,
+}
+
 struct Recorder<'e> {
     eqs: &'e StateEquations,
-    watchers: Vec<Watcher>,
     outputs: &'e [Output],
-    grid: Vec<f64>,
-    next: usize,
-    rows: Vec<Vec<f64>>,
+    grid: Grid,
+    sink: &'e mut dyn RowSink,
+    interrupt: Option<&'e AtomicBool>,
+    wants_steps: bool,
+    /// The segment ends at an event: its last step is handed on after the switch (as the
+    /// output row at an event time is), not before.
+    event_at: Option<f64>,
+    buf: Vec<f64>,
+    p: Progress,
 }
 
 impl Recorder<'_> {
-    fn record(&mut self, t: f64, x: &[f64]) {
+    /// `t` and the outputs at (t, x) into `buf`.
+    fn values(&mut self, t: f64, x: &[f64]) {
         self.eqs.evaluate(t, x);
-        let mut row = Vec::with_capacity(self.outputs.len() + 1);
-        row.push(t);
-        row.extend(self.outputs.iter().map(|o| self.eqs.read(o.probe, t, x)));
-        self.rows.push(row);
-        self.next += 1;
+        self.buf.clear();
+        self.buf.push(t);
+        let eqs = self.eqs;
+        self.buf
+            .extend(self.outputs.iter().map(|o| eqs.read(o.probe, t, x)));
+    }
+    /// The row of the pending grid time `t`; after a refused row, rows are skipped.
+    fn record(&mut self, t: f64, x: &[f64]) {
+        self.p.next += 1;
+        if self.p.stop.is_some() {
+            return;
+        }
+        self.values(t, x);
+        match self.sink.row(&self.buf) {
+            Ok(()) => self.p.rows += 1,
+            Err(message) => self.p.stop = Some(SimulationError::Output { t, message }),
+        }
     }
     fn pending(&self) -> Option<f64> {
-        self.grid.get(self.next).copied()
+        self.grid.at(self.p.next)
+    }
+    /// Every accepted step: watched minima, the sink's per-step values, and whether the run
+    /// must stop (a refused row, or the interruption flag).
+    fn accepted(&mut self, t: f64, x: &[f64]) -> Result<(), SimulationError> {
+        watch(&mut self.p.watchers, t, x);
+        if self.wants_steps && !self.event_at.is_some_and(|te| same_time(te, t)) {
+            self.step_values(t, x);
+        }
+        self.should_stop(t)
+    }
+    /// Hand the outputs at (t, x) to the sink as a step.
+    fn step_values(&mut self, t: f64, x: &[f64]) {
+        self.values(t, x);
+        self.sink.step(&self.buf);
+    }
+    fn should_stop(&mut self, t: f64) -> Result<(), SimulationError> {
+        if let Some(e) = self.p.stop.take() {
+            return Err(e);
+        }
+        if self.interrupt.is_some_and(|f| f.load(Ordering::Relaxed)) {
+            return Err(SimulationError::Interrupted { t });
+        }
+        Ok(())
     }
 }
 
@@ -416,14 +593,48 @@ fn same_time(a: f64, b: f64) -> bool {
     (a - b).abs() <= 1e-10 * (1.0 + a.abs().max(b.abs()))
 }
 
-/// Run a simulation.
+/// An outcome with no rows yet.
+fn start_outcome(settings: &Settings, outputs: &[Output], x0: &[f64]) -> Outcome {
+    let columns = std::iter::once("t".to_owned())
+        .chain(outputs.iter().map(|o| o.name.clone()))
+        .collect();
+    Outcome {
+        trajectory: Trajectory {
+            columns,
+            rows: Vec::new(),
+        },
+        rows: 0,
+        stats: Statistics::default(),
+        t_final: settings.t_start,
+        x_final: x0.to_vec(),
+        error: None,
+        watched: Vec::new(),
+    }
+}
+
+/// Refuse a run whose rows, kept in memory, would exceed [`MAX_VALUES_IN_MEMORY`].
 ///
-/// # Arguments
-/// * `eqs` — the equations; scheduled events replace elements in it (they stay replaced).
-/// * `x0` — initial state (use [`StateEquations::initial_state`]).
-/// * `settings`, `outputs` — solver settings and the columns to record besides `t`.
-/// * `events` — scheduled parameter switches, applied at their times (events at or before
-///   `t_start` are applied before the run).
+/// # Errors
+/// [`SimulationError::InvalidSetting`] on `dt_out`, saying how many values it asks for.
+pub fn check_in_memory(settings: &Settings, columns: usize) -> Result<(), SimulationError> {
+    let values = settings.output_rows() * columns as f64;
+    if values > MAX_VALUES_IN_MEMORY {
+        return Err(SimulationError::InvalidSetting {
+            setting: "dt_out",
+            message: format!(
+                "{} gives {:.3e} rows × {columns} columns = {values:.3e} values, more than the {MAX_VALUES_IN_MEMORY:e} a run kept in memory may hold (hint: stream the rows to a file: `bg-sim run` does, `simulate_into` in a program)",
+                settings.dt_out,
+                settings.output_rows()
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// Run a simulation and keep its rows in memory (in `trajectory.rows`).
+///
+/// As [`simulate_into`] with a sink that collects; refused (the outcome's error, no rows) if
+/// the rows would hold more than [`MAX_VALUES_IN_MEMORY`] values.
 ///
 /// # Returns
 /// An [`Outcome`] that always carries the rows computed, even when the run failed.
@@ -432,22 +643,49 @@ pub fn simulate(
     x0: &[f64],
     settings: &Settings,
     outputs: &[Output],
-    mut events: Vec<Event>,
+    events: Vec<Event>,
 ) -> Outcome {
-    let columns = std::iter::once("t".to_owned())
-        .chain(outputs.iter().map(|o| o.name.clone()))
-        .collect();
-    let mut out = Outcome {
-        trajectory: Trajectory {
-            columns,
-            rows: Vec::new(),
-        },
-        stats: Statistics::default(),
-        t_final: settings.t_start,
-        x_final: x0.to_vec(),
-        error: None,
-        watched: Vec::new(),
-    };
+    if let Err(e) = settings
+        .validate()
+        .and_then(|()| check_in_memory(settings, outputs.len() + 1))
+    {
+        let mut out = start_outcome(settings, outputs, x0);
+        out.error = Some(e);
+        return out;
+    }
+    let mut rows: Vec<Vec<f64>> = Vec::new();
+    let mut out = simulate_into(eqs, x0, settings, outputs, events, &mut rows);
+    out.trajectory.rows = rows;
+    out
+}
+
+/// Run a simulation, handing each output row to `sink` as it is computed.
+///
+/// # Arguments
+/// * `eqs` — the equations; scheduled events replace elements in it (they stay replaced).
+/// * `x0` — initial state (use [`StateEquations::initial_state`]).
+/// * `settings`, `outputs` — solver settings and the columns to record besides `t`.
+/// * `events` — scheduled parameter switches, applied at their times (events at or before
+///   `t_start` are applied before the run; events after `t_end` are not reached).
+/// * `sink` — receives every output row in time order; if it asks, the outputs at every
+///   accepted step too. A refused row stops the run.
+///
+/// A model with no states is not integrated: its rows are its outputs at the output times.
+/// The run stops early, keeping what the sink received, when the solver fails, a state is
+/// not finite, a limit is reached, the sink refuses a row or `settings.interrupt` is set.
+///
+/// # Returns
+/// An [`Outcome`] with the statistics, the number of rows delivered, and why the run stopped
+/// early, if it did; its `trajectory` has the column names and no rows.
+pub fn simulate_into(
+    eqs: &mut StateEquations,
+    x0: &[f64],
+    settings: &Settings,
+    outputs: &[Output],
+    mut events: Vec<Event>,
+    sink: &mut dyn RowSink,
+) -> Outcome {
+    let mut out = start_outcome(settings, outputs, x0);
     if let Err(e) = settings.validate() {
         out.error = Some(e);
         return out;
@@ -478,22 +716,25 @@ pub fn simulate(
     let start = Instant::now();
     events.sort_by(|a, b| a.t.total_cmp(&b.t));
     let (t0, t_end) = (settings.t_start, settings.t_end);
-    let n_out = ((t_end - t0) / settings.dt_out + 1e-9).floor() as usize;
-    let mut grid: Vec<f64> = (0..=n_out)
-        .map(|k| t0 + k as f64 * settings.dt_out)
-        .collect();
-    if grid.last().is_some_and(|&t| !same_time(t, t_end)) {
-        grid.push(t_end);
-    }
+    let grid = Grid::new(settings);
+    let interrupt = settings.interrupt.as_deref();
+    let wants_steps = sink.wants_steps();
     let mut x = x0.to_vec();
     let mut t = t0;
     let mut events = events.into_iter().peekable();
-    let mut rows = Vec::new();
-    let mut watchers = watchers(eqs);
-    watch(&mut watchers, t0, x0);
+    let mut progress = Progress {
+        watchers: watchers(eqs),
+        next: 0,
+        rows: 0,
+        stop: None,
+    };
+    let mut buf = Vec::with_capacity(outputs.len() + 1);
+    watch(&mut progress.watchers, t0, x0);
     loop {
         // Apply every event due now.
+        let mut switched = false;
         while let Some(ev) = events.next_if(|e| e.t <= t || same_time(e.t, t)) {
+            switched = true;
             // All or nothing: check every replacement before applying any.
             let refused = ev
                 .replacements
@@ -513,29 +754,50 @@ pub fn simulate(
         if out.error.is_some() {
             break;
         }
+        let t_stop = events.peek().map_or(t_end, |e| e.t.min(t_end));
         let mut rec = Recorder {
             eqs,
-            watchers: std::mem::take(&mut watchers),
             outputs,
-            grid: std::mem::take(&mut grid),
-            next: 0,
-            rows: std::mem::take(&mut rows),
+            grid,
+            sink: &mut *sink,
+            interrupt,
+            wants_steps,
+            event_at: (t_stop < t_end).then_some(t_stop),
+            buf: std::mem::take(&mut buf),
+            p: progress,
         };
+        // The step that reached an event time, after the switch.
+        if switched && wants_steps && t > t0 {
+            rec.step_values(t, &x);
+        }
         // Rows due at the current time (after the events).
-        rec.next = rec.rows.len();
         while rec.pending().is_some_and(|g| same_time(g, t)) {
             rec.record(t, &x);
         }
-        let t_stop = events.peek().map_or(t_end, |e| e.t.min(t_end));
-        if t >= t_end || same_time(t, t_end) {
-            rows = rec.rows;
-            watchers = rec.watchers;
-            break;
-        }
-        let seg = run_segment(&mut rec, settings, t, t_stop, &x, &mut out.stats);
-        grid = rec.grid;
-        rows = rec.rows;
-        watchers = rec.watchers;
+        let seg = if t >= t_end || same_time(t, t_end) {
+            None
+        } else if x.is_empty() {
+            Some(record_without_states(&mut rec, t_stop))
+        } else {
+            Some(run_segment(
+                &mut rec,
+                settings,
+                t,
+                t_stop,
+                &x,
+                &mut out.stats,
+            ))
+        };
+        // A row refused at the end of the segment stops the run here.
+        let refused = rec.p.stop.take();
+        buf = rec.buf;
+        progress = rec.p;
+        let seg = match (seg, refused) {
+            (Some(Ok(xs)), Some(e)) => Err((t_stop, xs, e)),
+            (None, Some(e)) => Err((t, x.clone(), e)),
+            (Some(s), _) => s,
+            (None, None) => break,
+        };
         match seg {
             Ok(xs) => {
                 x = xs;
@@ -549,12 +811,25 @@ pub fn simulate(
             }
         }
     }
-    out.trajectory.rows = rows;
-    out.watched = reports(watchers);
+    out.rows = progress.rows;
+    out.watched = reports(progress.watchers);
     out.t_final = t;
     out.x_final = x;
     out.stats.wall_time = start.elapsed();
     out
+}
+
+/// A model with no states has nothing to integrate: its rows strictly before `t_stop` are its
+/// outputs at the output times.
+fn record_without_states(rec: &mut Recorder<'_>, t_stop: f64) -> Result<Vec<f64>, SegmentError> {
+    while let Some(tg) = rec.pending() {
+        if tg > t_stop || same_time(tg, t_stop) {
+            break;
+        }
+        rec.accepted(tg, &[]).map_err(|e| (tg, Vec::new(), e))?;
+        rec.record(tg, &[]);
+    }
+    Ok(Vec::new())
 }
 
 type SegmentError = (f64, Vec<f64>, SimulationError);
@@ -859,7 +1134,12 @@ fn drive(
             };
             return Err((t, x, solver_error(t, message, culprit(eqs, bad))));
         }
-        watch(&mut rec.watchers, t, &x);
+        // The run observes an interruption (`Settings::interrupt`) and a refused row here, in
+        // one place, after every accepted step; the per-step outputs (checks) are handed on too.
+        if let Err(e) = rec.accepted(t, &x) {
+            finish(s, stats);
+            return Err((t, x, e));
+        }
         if let Some(i) = x.iter().position(|v| !v.is_finite()) {
             finish(s, stats);
             let info = &eqs.states()[i];

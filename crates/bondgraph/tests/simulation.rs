@@ -462,3 +462,211 @@ fn statistics_are_consistent() {
         }
     }
 }
+
+/// Issue "hardening" #9: a model with no states (`Se -> R`) panicked in diffsol ("Matrix
+/// slicing out of bounds"). It has nothing to integrate: its rows are its outputs.
+#[test]
+fn a_model_without_states_gives_its_outputs_at_the_output_times() {
+    let mut g = BondGraph::new();
+    g.add("src", EffortSource::new(2.0)).unwrap();
+    g.add("r", Resistor::new(4.0).unwrap()).unwrap();
+    bond_all(&mut g, &[("src", "r")]);
+    let mut eqs = assemble(g);
+    assert_eq!(eqs.n_states(), 0);
+    let outs = [output(&eqs, "r.f"), output(&eqs, "r.P")];
+    for method in Method::ALL {
+        let run = simulate(
+            &mut eqs,
+            &[],
+            &settings(method, 1.0, 0.25, 1e-6, 1e-8),
+            &outs,
+            vec![],
+        );
+        assert!(run.error.is_none(), "{method:?}: {:?}", run.error);
+        assert_eq!(col(&run.trajectory, "t"), [0.0, 0.25, 0.5, 0.75, 1.0]);
+        assert!(col(&run.trajectory, "r.f")
+            .iter()
+            .all(|f| (*f - 0.5).abs() < 1e-15));
+        assert!(col(&run.trajectory, "r.P")
+            .iter()
+            .all(|p| (*p - 1.0).abs() < 1e-15));
+        assert_eq!(run.rows, 5);
+    }
+}
+
+/// Issue "hardening" #4: at t ≈ 1e16 f64 times are 2 s apart; a 2 s run gave "steps 0" and
+/// 10 001 identical rows with exit 0. Now it is refused, and so is an rtol f64 cannot meet.
+#[test]
+fn times_and_tolerances_beyond_f64_resolution_are_refused() {
+    let mut eqs = mass_spring_damper(1.0, 100.0, 0.4, 0.01);
+    let x0 = eqs.initial_state();
+    for s in [
+        Settings {
+            t_start: 1e16,
+            t_end: 1.000_000_000_000_01e16,
+            dt_out: 2e-4,
+            ..Settings::default()
+        },
+        Settings {
+            t_end: 1e-12,
+            dt_out: 1e-13,
+            ..Settings::default()
+        },
+        Settings {
+            rtol: 1e-300,
+            ..Settings::default()
+        },
+        Settings {
+            t_end: 10.0,
+            dt_out: 1e-9,
+            ..Settings::default()
+        },
+    ] {
+        let run = simulate(&mut eqs, &x0, &s, &[], vec![]);
+        assert!(
+            matches!(run.error, Some(SimulationError::InvalidSetting { .. })),
+            "{s:?}: {:?}",
+            run.error
+        );
+        assert_eq!(run.trajectory.rows.len(), 0);
+    }
+    // far from the origin, but resolvable: fine
+    let s = Settings {
+        t_start: 1e6,
+        t_end: 1e6 + 1.0,
+        dt_out: 0.5,
+        ..Settings::default()
+    };
+    let run = simulate(&mut eqs, &x0, &s, &[], vec![]);
+    assert!(run.error.is_none(), "{:?}", run.error);
+    assert_eq!(col(&run.trajectory, "t"), [1e6, 1e6 + 0.5, 1e6 + 1.0]);
+}
+
+/// A sink that keeps rows and counts the accepted steps it was shown.
+#[derive(Default)]
+struct Counting {
+    rows: Vec<Vec<f64>>,
+    steps: Vec<f64>,
+    refuse_after: Option<usize>,
+}
+
+impl RowSink for Counting {
+    fn row(&mut self, row: &[f64]) -> Result<(), String> {
+        if self.refuse_after.is_some_and(|n| self.rows.len() >= n) {
+            return Err("disk full".into());
+        }
+        self.rows.push(row.to_vec());
+        Ok(())
+    }
+    fn wants_steps(&self) -> bool {
+        true
+    }
+    fn step(&mut self, values: &[f64]) {
+        self.steps.push(values[0]);
+    }
+}
+
+/// Issue "hardening" #5/#7: rows stream to a sink as they are computed (the same rows as in
+/// memory), and the sink sees the outputs at every accepted step in between (#6).
+#[test]
+fn rows_stream_to_a_sink_with_every_accepted_step() {
+    let s = settings(Method::Bdf, 1.0, 0.1, 1e-8, 1e-12);
+    let mut eqs = mass_spring_damper(1.0, 100.0, 0.4, 0.01);
+    let x0 = eqs.initial_state();
+    let outs = [output(&eqs, "spring.q")];
+    let kept = simulate(&mut eqs, &x0, &s, &outs, vec![]);
+    let mut sink = Counting::default();
+    let streamed = simulate_into(&mut eqs, &x0, &s, &outs, vec![], &mut sink);
+    assert!(streamed.error.is_none(), "{:?}", streamed.error);
+    assert!(streamed.trajectory.rows.is_empty());
+    assert_eq!(streamed.rows, 11);
+    assert_eq!(sink.rows, kept.trajectory.rows);
+    assert_eq!(sink.steps.len(), streamed.stats.steps);
+    assert!(sink.steps.windows(2).all(|w| w[0] < w[1]));
+}
+
+/// A refused row (a full disk) stops the run at once, keeping the rows before it.
+#[test]
+fn a_refused_row_stops_the_run() {
+    let s = settings(Method::Bdf, 1.0, 0.01, 1e-8, 1e-12);
+    let mut eqs = mass_spring_damper(1.0, 100.0, 0.4, 0.01);
+    let x0 = eqs.initial_state();
+    let mut sink = Counting {
+        refuse_after: Some(30),
+        ..Counting::default()
+    };
+    let run = simulate_into(&mut eqs, &x0, &s, &[], vec![], &mut sink);
+    assert!(
+        matches!(&run.error, Some(SimulationError::Output { message, .. }) if message == "disk full"),
+        "{:?}",
+        run.error
+    );
+    assert_eq!(sink.rows.len(), 30);
+    assert_eq!(run.rows, 30);
+    assert!(run.t_final < 0.35, "stopped soon after: {}", run.t_final);
+}
+
+/// Issue "hardening" #5: an interruption (SIGINT/SIGTERM in the CLI) stops the run after the
+/// current step and keeps the rows so far.
+#[test]
+fn the_interrupt_flag_stops_the_run_and_keeps_the_rows() {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+    struct StopAt(Arc<AtomicBool>, Vec<Vec<f64>>);
+    impl RowSink for StopAt {
+        fn row(&mut self, row: &[f64]) -> Result<(), String> {
+            if row[0] >= 0.5 {
+                self.0.store(true, Ordering::Relaxed);
+            }
+            self.1.push(row.to_vec());
+            Ok(())
+        }
+    }
+    let flag = Arc::new(AtomicBool::new(false));
+    let s = Settings {
+        interrupt: Some(Arc::clone(&flag)),
+        ..settings(Method::Bdf, 10.0, 0.01, 1e-8, 1e-12)
+    };
+    let mut eqs = mass_spring_damper(1.0, 100.0, 0.4, 0.01);
+    let x0 = eqs.initial_state();
+    let mut sink = StopAt(flag, Vec::new());
+    let run = simulate_into(&mut eqs, &x0, &s, &[], vec![], &mut sink);
+    assert!(
+        matches!(run.error, Some(SimulationError::Interrupted { .. })),
+        "{:?}",
+        run.error
+    );
+    assert!(sink.1.len() >= 51 && sink.1.len() < 80, "{}", sink.1.len());
+    assert_eq!(run.rows, sink.1.len());
+}
+
+/// Issue "hardening" #7: the 1e7-row cap ignored the columns. Rows kept in memory are now
+/// bounded by rows × columns; streamed rows only by `MAX_OUTPUT_ROWS`.
+#[test]
+fn rows_kept_in_memory_are_bounded_by_values_not_rows() {
+    let mut eqs = mass_spring_damper(1.0, 100.0, 0.4, 0.01);
+    let x0 = eqs.initial_state();
+    let outs: Vec<Output> = (0..99).map(|_| output(&eqs, "spring.q")).collect();
+    // 1e6 rows × 100 columns = 1e8 values: refused in memory, before any step
+    let s = settings(Method::Bdf, 1.0, 1e-6, 1e-6, 1e-8);
+    let run = simulate(&mut eqs, &x0, &s, &outs, vec![]);
+    assert!(
+        matches!(&run.error, Some(SimulationError::InvalidSetting { setting: "dt_out", message }) if message.contains("columns")),
+        "{:?}",
+        run.error
+    );
+    assert_eq!(run.stats.steps, 0);
+    // the same rows into a sink that drops them: fine
+    struct Drop(usize);
+    impl RowSink for Drop {
+        fn row(&mut self, _: &[f64]) -> Result<(), String> {
+            self.0 += 1;
+            Ok(())
+        }
+    }
+    let s = settings(Method::Bdf, 0.1, 1e-6, 1e-6, 1e-8);
+    let mut sink = Drop(0);
+    let run = simulate_into(&mut eqs, &x0, &s, &outs, vec![], &mut sink);
+    assert!(run.error.is_none(), "{:?}", run.error);
+    assert_eq!(sink.0, 100_001);
+}

@@ -31,9 +31,9 @@ fn last(v: &[f64]) -> f64 {
 #[test]
 fn reaches_the_set_point_short_by_the_leakage_offset_and_holds_the_load() {
     let mut m = load("cylinder_lift", &[]).unwrap();
-    let out = m.run().unwrap();
+    let (out, checks) = m.run_checked().unwrap();
     assert!(out.error.is_none(), "{:?}", out.error);
-    for c in m.verify(&out.trajectory) {
+    for c in checks {
         assert!(c.passed, "check {} failed: {:e}", c.value, c.max_error);
     }
     let (p_p_ss, p_r_ss, x_ss, offset) = steady_state(&m);
@@ -216,4 +216,39 @@ fn check_lists_every_member_of_the_cylinder() {
         assert!(states.contains(&s), "{s} missing from {states:?}");
     }
     assert_eq!(ins.bonds.len(), 14);
+}
+
+/// Issue "hardening" #6: the "never sinks" check passed at `dt_out = 0.01` and failed at
+/// `0.001` with the same 602 steps: it looked only at the output rows. Checked at every
+/// accepted step, it sees the 0.72 µm dip at t ≈ 6 ms whatever the output interval.
+#[test]
+fn checks_see_every_accepted_step_whatever_the_output_interval() {
+    let sink_check = |dt_out: &str| {
+        let mut m = load("cylinder_lift", &[&format!("simulation.dt_out={dt_out}")]).unwrap();
+        let (out, checks) = m.run_checked().unwrap();
+        assert!(out.error.is_none(), "{:?}", out.error);
+        let c = checks
+            .into_iter()
+            .find(|c| c.value.starts_with("min(l - (l0 + s0)"))
+            .unwrap();
+        assert!(c.every_step && c.points > out.stats.steps);
+        (c.max_error, out.rows)
+    };
+    let (coarse, rows_coarse) = sink_check("0.01");
+    let (fine, rows_fine) = sink_check("0.001");
+    assert_eq!((rows_coarse, rows_fine), (1001, 10_001));
+    assert!(coarse > 5e-7 && coarse < 1e-6, "{coarse:e}");
+    assert!(
+        (fine - coarse).abs() <= 0.05 * coarse,
+        "{fine:e} vs {coarse:e}"
+    );
+    // the output rows alone miss it at dt_out = 0.01
+    let mut m = load("cylinder_lift", &[]).unwrap();
+    let out = m.run().unwrap();
+    let sampled = m
+        .verify(&out.trajectory)
+        .into_iter()
+        .find(|c| c.value.starts_with("min(l - (l0 + s0)"))
+        .unwrap();
+    assert!(!sampled.every_step && sampled.max_error < 1e-9);
 }

@@ -58,7 +58,7 @@ impl ModelError {
             line: None,
             col: None,
             element: None,
-            message: message.into(),
+            message: clip_to(&message.into(), MAX_MESSAGE),
             hint: None,
         }
     }
@@ -74,7 +74,7 @@ impl ModelError {
         self
     }
     pub(crate) fn hint(mut self, hint: impl Into<String>) -> Self {
-        self.hint = Some(hint.into());
+        self.hint = Some(clip_to(&hint.into(), MAX_MESSAGE));
         self
     }
 }
@@ -101,6 +101,26 @@ impl fmt::Display for ModelError {
 }
 
 impl std::error::Error for ModelError {}
+
+/// Longest piece of user input an error message repeats, in characters.
+pub const MAX_ECHO: usize = 80;
+
+/// Longest message or hint, in characters: the rest is cut (a 10 MB value must not come
+/// back on stderr).
+pub const MAX_MESSAGE: usize = 2_000;
+
+/// `s` cut to [`MAX_ECHO`] characters, saying how much was left out.
+#[must_use]
+pub fn clip(s: &str) -> String {
+    clip_to(s, MAX_ECHO)
+}
+
+fn clip_to(s: &str, max: usize) -> String {
+    match s.char_indices().nth(max) {
+        None => s.to_owned(),
+        Some((i, _)) => format!("{}… ({} more characters)", &s[..i], s[i..].chars().count()),
+    }
+}
 
 /// Line and column (1-based) of byte `offset` in `text`.
 pub(crate) fn line_col(text: &str, offset: usize) -> (usize, usize) {

@@ -33,6 +33,14 @@ pub const FUNCTIONS: &[(&str, Option<usize>)] = &[
     ("rad", Some(1)),
 ];
 
+/// Longest expression, in characters.
+pub const MAX_EXPR_LEN: usize = 10_000;
+
+/// Deepest expression: every parenthesis, sign, function call and operator is one level, and
+/// a chain `a + b + c` is as deep as it has operators. Deeper expressions would overflow the
+/// stack of the parser and of the evaluation.
+pub const MAX_EXPR_DEPTH: usize = 200;
+
 /// Names that are not parameters: `pi` and `t` (time).
 pub const RESERVED: &[&str] = &["pi", "t", "time"];
 
@@ -69,9 +77,22 @@ pub enum Expr {
 impl Expr {
     /// Parse `src`.
     pub fn parse(src: &str) -> Result<Self, ExprError> {
+        let n = src.chars().count();
+        if n > MAX_EXPR_LEN {
+            return Err(ExprError {
+                pos: MAX_EXPR_LEN,
+                message: format!(
+                    "the expression has {n} characters, more than {MAX_EXPR_LEN}; split it into named parameters"
+                ),
+            });
+        }
         let chars: Vec<char> = src.chars().collect();
-        let mut p = Parser { c: &chars, i: 0 };
-        let e = p.sum()?;
+        let mut p = Parser {
+            c: &chars,
+            i: 0,
+            nest: 0,
+        };
+        let (e, _) = p.sum()?;
         p.ws();
         if p.i < chars.len() {
             return Err(p.err(format!("unexpected `{}`", chars[p.i])));
@@ -211,6 +232,8 @@ fn call(f: &str, v: &[f64]) -> f64 {
         "pow" => v[0].powf(v[1]),
         "min" => v.iter().copied().fold(f64::INFINITY, f64::min),
         "max" => v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        // bounds in the wrong order give NaN, which the run reports, not a silent `hi`
+        "clamp" if v[1] > v[2] => f64::NAN,
         "clamp" => v[0].max(v[1]).min(v[2]),
         "deg" => v[0].to_degrees(),
         "rad" => v[0].to_radians(),
@@ -271,10 +294,39 @@ fn eval_node(n: &Node, u: &[f64]) -> f64 {
     }
 }
 
+/// `clamp(x, lo, hi)`: refuse the arguments in an order that cannot be meant: constant
+/// bounds with lo > hi, or a constant first argument with a variable last one
+/// (`clamp(0, 1, x)` for `clamp(x, 0, 1)`).
+fn check_clamp(name: &str, args: &[Expr], start: usize) -> Result<(), ExprError> {
+    if name != "clamp" || args.len() != 3 {
+        return Ok(());
+    }
+    let constant = |e: &Expr| e.names().iter().all(|n| n == "pi");
+    let value = |e: &Expr| e.eval(&|_| None).ok();
+    let msg = if let (Some(lo), Some(hi)) = (value(&args[1]), value(&args[2])) {
+        (lo > hi).then(|| format!("`clamp(x, lo, hi)` has lo = {lo} > hi = {hi}"))
+    } else if constant(&args[0]) && !constant(&args[2]) {
+        Some("`clamp(x, lo, hi)` takes the value first, then the bounds: the first argument is a constant and the last is not (did you mean `clamp(x, lo, hi)` for `clamp(lo, hi, x)`?)".to_owned())
+    } else {
+        None
+    };
+    msg.map_or(Ok(()), |message| {
+        Err(ExprError {
+            pos: start,
+            message,
+        })
+    })
+}
+
 struct Parser<'a> {
     c: &'a [char],
     i: usize,
+    /// Current recursion depth of the parser.
+    nest: usize,
 }
+
+/// An expression and its depth.
+type Parsed = (Expr, usize);
 
 impl Parser<'_> {
     fn err(&self, message: String) -> ExprError {
@@ -282,6 +334,26 @@ impl Parser<'_> {
             pos: self.i,
             message,
         }
+    }
+    fn too_deep(&self) -> ExprError {
+        self.err(format!(
+            "the expression is nested more than {MAX_EXPR_DEPTH} levels deep (parentheses, signs, calls, operators); split it into named parameters"
+        ))
+    }
+    /// One level deeper into the parser; refused past [`MAX_EXPR_DEPTH`].
+    fn enter(&mut self) -> Result<(), ExprError> {
+        self.nest += 1;
+        if self.nest > MAX_EXPR_DEPTH {
+            return Err(self.too_deep());
+        }
+        Ok(())
+    }
+    /// A node over children of depth `d`, refused past [`MAX_EXPR_DEPTH`].
+    fn node(&self, e: Expr, d: usize) -> Result<Parsed, ExprError> {
+        if d + 1 > MAX_EXPR_DEPTH {
+            return Err(self.too_deep());
+        }
+        Ok((e, d + 1))
     }
     fn ws(&mut self) {
         while self.i < self.c.len() && self.c[self.i].is_whitespace() {
@@ -292,47 +364,51 @@ impl Parser<'_> {
         self.ws();
         self.c.get(self.i).copied()
     }
-    fn sum(&mut self) -> Result<Expr, ExprError> {
-        let mut a = self.product()?;
+    fn sum(&mut self) -> Result<Parsed, ExprError> {
+        self.enter()?;
+        let (mut a, mut da) = self.product()?;
         while let Some(op @ ('+' | '-')) = self.peek() {
             self.i += 1;
-            let b = self.product()?;
-            a = Expr::Bin(op, Box::new(a), Box::new(b));
+            let (b, db) = self.product()?;
+            (a, da) = self.node(Expr::Bin(op, Box::new(a), Box::new(b)), da.max(db))?;
         }
-        Ok(a)
+        self.nest -= 1;
+        Ok((a, da))
     }
-    fn product(&mut self) -> Result<Expr, ExprError> {
-        let mut a = self.unary()?;
+    fn product(&mut self) -> Result<Parsed, ExprError> {
+        let (mut a, mut da) = self.unary()?;
         while let Some(op @ ('*' | '/')) = self.peek() {
             self.i += 1;
-            let b = self.unary()?;
-            a = Expr::Bin(op, Box::new(a), Box::new(b));
+            let (b, db) = self.unary()?;
+            (a, da) = self.node(Expr::Bin(op, Box::new(a), Box::new(b)), da.max(db))?;
         }
-        Ok(a)
+        Ok((a, da))
     }
-    fn unary(&mut self) -> Result<Expr, ExprError> {
-        match self.peek() {
-            Some('-') => {
-                self.i += 1;
-                Ok(Expr::Neg(Box::new(self.unary()?)))
-            }
-            Some('+') => {
-                self.i += 1;
-                self.unary()
-            }
-            _ => self.power(),
+    fn unary(&mut self) -> Result<Parsed, ExprError> {
+        let sign = self.peek();
+        if !matches!(sign, Some('-' | '+')) {
+            return self.power();
+        }
+        self.i += 1;
+        self.enter()?;
+        let (a, d) = self.unary()?;
+        self.nest -= 1;
+        if sign == Some('-') {
+            self.node(Expr::Neg(Box::new(a)), d)
+        } else {
+            Ok((a, d))
         }
     }
-    fn power(&mut self) -> Result<Expr, ExprError> {
-        let base = self.atom()?;
+    fn power(&mut self) -> Result<Parsed, ExprError> {
+        let (base, db) = self.atom()?;
         if self.peek() == Some('^') {
             self.i += 1;
-            let exp = self.unary()?;
-            return Ok(Expr::Bin('^', Box::new(base), Box::new(exp)));
+            let (exp, de) = self.unary()?;
+            return self.node(Expr::Bin('^', Box::new(base), Box::new(exp)), db.max(de));
         }
-        Ok(base)
+        Ok((base, db))
     }
-    fn atom(&mut self) -> Result<Expr, ExprError> {
+    fn atom(&mut self) -> Result<Parsed, ExprError> {
         match self.peek() {
             None => Err(self.err("expression ends too early".into())),
             Some('(') => {
@@ -344,7 +420,7 @@ impl Parser<'_> {
                 self.i += 1;
                 Ok(e)
             }
-            Some(c) if c.is_ascii_digit() || c == '.' => self.number(),
+            Some(c) if c.is_ascii_digit() || c == '.' => Ok((self.number()?, 1)),
             Some(c) if c.is_alphabetic() || c == '_' => self.name(),
             Some(c) => Err(self.err(format!("unexpected `{c}`"))),
         }
@@ -376,10 +452,10 @@ impl Parser<'_> {
             .collect();
         s.parse().map(Expr::Num).map_err(|_| ExprError {
             pos: start,
-            message: format!("`{s}` is not a number"),
+            message: format!("`{}` is not a number", crate::error::clip(&s)),
         })
     }
-    fn name(&mut self) -> Result<Expr, ExprError> {
+    fn name(&mut self) -> Result<Parsed, ExprError> {
         let start = self.i;
         while self.i < self.c.len()
             && (self.c[self.i].is_alphanumeric() || self.c[self.i] == '_' || self.c[self.i] == '.')
@@ -403,7 +479,7 @@ impl Parser<'_> {
         if name.ends_with('.') {
             return Err(ExprError {
                 pos: start,
-                message: format!("`{name}` is not a valid name"),
+                message: format!("`{}` is not a valid name", crate::error::clip(&name)),
             });
         }
         if self.peek() == Some('(') {
@@ -411,14 +487,21 @@ impl Parser<'_> {
                 let known: Vec<&str> = FUNCTIONS.iter().map(|(f, _)| *f).collect();
                 return Err(ExprError {
                     pos: start,
-                    message: format!("unknown function `{name}`; known: {}", known.join(", ")),
+                    message: format!(
+                        "unknown function `{}`; known: {}",
+                        crate::error::clip(&name),
+                        known.join(", ")
+                    ),
                 });
             };
             self.i += 1;
             let mut args = Vec::new();
+            let mut depth = 0;
             if self.peek() != Some(')') {
                 loop {
-                    args.push(self.sum()?);
+                    let (a, d) = self.sum()?;
+                    args.push(a);
+                    depth = depth.max(d);
                     match self.peek() {
                         Some(',') => self.i += 1,
                         Some(')') => break,
@@ -441,9 +524,10 @@ impl Parser<'_> {
                     ),
                 });
             }
-            return Ok(Expr::Call(name, args));
+            check_clamp(&name, &args, start)?;
+            return self.node(Expr::Call(name, args), depth);
         }
-        Ok(Expr::Name(name))
+        Ok((Expr::Name(name), 1))
     }
 }
 
@@ -493,6 +577,73 @@ mod tests {
             .message
             .contains("takes 2"));
         assert!(Expr::parse("2 $ 3").is_err());
+    }
+
+    /// Issue "hardening" #1: ~8 300 nested parentheses, 15 800 minus signs or a 52 000-term
+    /// sum overflowed the stack (abort, exit 134). Each is now refused, on a small stack too.
+    #[test]
+    fn deep_or_long_expressions_are_refused_not_a_stack_overflow() {
+        let deep = [
+            format!("{}10{}", "(".repeat(9000), ")".repeat(9000)),
+            format!("{}10", "-".repeat(15_800)),
+            format!("{}10", "+".repeat(15_800)),
+            vec!["1"; 4_000].join("+"),
+            vec!["1"; 4_000].join("*"),
+            format!("{}1{}", "sqrt(".repeat(300), ")".repeat(300)),
+            format!("{}2", "2^".repeat(300)),
+            vec!["1"; 52_000].join("+"),
+        ];
+        let handle = std::thread::Builder::new()
+            .stack_size(256 * 1024)
+            .spawn(move || {
+                deep.iter()
+                    .map(|s| Expr::parse(s).unwrap_err().message)
+                    .collect::<Vec<_>>()
+            })
+            .unwrap();
+        for m in handle.join().unwrap() {
+            assert!(
+                m.contains("nested more than 200") || m.contains("more than 10000"),
+                "{m}"
+            );
+        }
+        // up to the limits: parsed and evaluated, also on a small stack
+        let fine = std::thread::Builder::new()
+            .stack_size(256 * 1024)
+            .spawn(|| {
+                let sum = vec!["1"; 199].join("+");
+                let parens = format!("{}2{}", "(".repeat(199), ")".repeat(199));
+                let signs = format!("{}2", "-".repeat(198));
+                [sum, parens, signs].map(|s| Expr::parse(&s).unwrap().eval(&|_| None).unwrap())
+            })
+            .unwrap()
+            .join()
+            .unwrap();
+        assert!(fine
+            .iter()
+            .zip([199.0, 2.0, 2.0])
+            .all(|(a, b)| (a - b).abs() < 1e-12));
+    }
+
+    /// Issue "hardening" #10: `clamp(0, 1, x)` (bounds first) was accepted and gave 1.
+    #[test]
+    fn clamp_with_its_arguments_in_the_wrong_order_is_refused() {
+        for bad in ["clamp(0, 1, x)", "clamp(x, 1, 0)", "clamp(x, 2*pi, 0)"] {
+            let e = Expr::parse(bad).unwrap_err();
+            assert!(e.message.contains("clamp(x, lo, hi)"), "{bad}: {e}");
+        }
+        assert!((ev("clamp(k, 0, 1)") - 1.0).abs() < 1e-15);
+        // bounds only known at run time, in the wrong order: NaN, not a silent `hi`
+        let e = Expr::parse("clamp(x, lo, hi)").unwrap();
+        let v = e
+            .eval(&|n| match n {
+                "x" => Some(0.5),
+                "lo" => Some(1.0),
+                "hi" => Some(0.0),
+                _ => None,
+            })
+            .unwrap();
+        assert!(v.is_nan());
     }
 
     #[test]

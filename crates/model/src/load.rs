@@ -3,7 +3,7 @@
 //! and column, the element and a hint.
 
 use std::cell::RefCell;
-use std::collections::{HashMap, HashSet};
+use std::collections::HashSet;
 use std::ops::Range;
 use std::path::Path;
 
@@ -15,7 +15,7 @@ use indexmap::IndexMap;
 use serde::Deserialize;
 use toml::Spanned;
 
-use crate::error::{line_col, ErrorKind, ModelError};
+use crate::error::{clip, line_col, ErrorKind, ModelError};
 use crate::expr::{Expr, RESERVED};
 use crate::registry::{ElementSpec, RawValue, Registry};
 
@@ -88,7 +88,7 @@ pub struct Check {
 pub struct CheckResult {
     /// What was checked.
     pub value: String,
-    /// Largest |value − expected| over the rows.
+    /// Largest |value − expected| over the points evaluated.
     pub max_error: f64,
     /// Time of the largest error.
     pub t_worst: f64,
@@ -96,6 +96,120 @@ pub struct CheckResult {
     pub tol: f64,
     /// `max_error <= tol` (and every value finite).
     pub passed: bool,
+    /// How many points were evaluated (output rows, plus accepted steps if `every_step`).
+    pub points: usize,
+    /// Evaluated at every accepted solver step as well as at every output row
+    /// ([`Model::run_into`]); `false`: at the output rows only ([`Model::verify`]).
+    pub every_step: bool,
+}
+
+/// The worst error of one check so far.
+#[derive(Clone, Copy)]
+struct Worst {
+    error: f64,
+    t: f64,
+    finite: bool,
+}
+
+impl Worst {
+    const NONE: Self = Self {
+        error: 0.0,
+        t: f64::NAN,
+        finite: true,
+    };
+    fn add(&mut self, t: f64, error: f64) {
+        if !error.is_finite() {
+            self.finite = false;
+        }
+        if error > self.error || self.t.is_nan() {
+            self.error = error;
+            self.t = t;
+        }
+    }
+    fn result(self, c: &Check, points: usize, every_step: bool) -> CheckResult {
+        CheckResult {
+            value: c.value.clone(),
+            max_error: self.error,
+            t_worst: self.t,
+            tol: c.tol,
+            passed: points > 0 && self.finite && self.error <= c.tol,
+            points,
+            every_step,
+        }
+    }
+}
+
+/// Evaluates the checks at every output row and every accepted step, and hands the rows on.
+struct CheckSink<'a> {
+    inner: &'a mut dyn bondgraph::RowSink,
+    /// Compiled (value, expected) of each check, reading the columns (`t` first).
+    compiled: Vec<(crate::expr::Compiled, crate::expr::Compiled)>,
+    worst: Vec<Worst>,
+    points: usize,
+}
+
+impl<'a> CheckSink<'a> {
+    fn new(model: &Model, inner: &'a mut dyn bondgraph::RowSink) -> Result<Self, ModelError> {
+        let columns: Vec<String> = std::iter::once("t".to_owned())
+            .chain(model.outputs.iter().map(|o| o.name.clone()))
+            .collect();
+        let constant = |n: &str| {
+            if columns.iter().any(|c| c == n) {
+                None
+            } else {
+                model.parameters.get(n).copied()
+            }
+        };
+        let mut compiled = Vec::new();
+        for c in &model.checks {
+            let compile = |e: &Expr| {
+                e.compile(&constant, &columns).map_err(|m| {
+                    model.source.err(
+                        ErrorKind::Settings,
+                        None,
+                        format!("[[check]] {}: {m}", clip(&c.value)),
+                    )
+                })
+            };
+            compiled.push((compile(&c.value_expr)?, compile(&c.expected_expr)?));
+        }
+        Ok(Self {
+            inner,
+            worst: vec![Worst::NONE; compiled.len()],
+            compiled,
+            points: 0,
+        })
+    }
+    fn evaluate(&mut self, values: &[f64]) {
+        self.points += 1;
+        let t = values.first().copied().unwrap_or(f64::NAN);
+        for ((v, e), w) in self.compiled.iter().zip(&mut self.worst) {
+            w.add(t, (v.eval(values) - e.eval(values)).abs());
+        }
+    }
+    fn results(&self, checks: &[Check]) -> Vec<CheckResult> {
+        checks
+            .iter()
+            .zip(&self.worst)
+            .map(|(c, w)| w.result(c, self.points, true))
+            .collect()
+    }
+}
+
+impl bondgraph::RowSink for CheckSink<'_> {
+    fn row(&mut self, row: &[f64]) -> Result<(), String> {
+        self.evaluate(row);
+        self.inner.row(row)
+    }
+    fn wants_steps(&self) -> bool {
+        !self.compiled.is_empty() || self.inner.wants_steps()
+    }
+    fn step(&mut self, values: &[f64]) {
+        self.evaluate(values);
+        if self.inner.wants_steps() {
+            self.inner.step(values);
+        }
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -129,6 +243,14 @@ enum BuiltDef {
     Many(crate::registry::Composite),
 }
 
+/// A parameter being evaluated: its expression, the names it uses and the next to look at.
+struct PendingParam {
+    name: String,
+    expr: Expr,
+    names: Vec<String>,
+    next: usize,
+}
+
 #[derive(Clone, Debug)]
 struct EventDef {
     t: f64,
@@ -145,6 +267,8 @@ struct Source {
     param_exprs: IndexMap<String, RawValue>,
     elements: Vec<ElementDef>,
     events: Vec<EventDef>,
+    /// Lines (1-based) that `--set` wrote or changed: errors there say so.
+    changed_lines: Vec<usize>,
 }
 
 impl Source {
@@ -154,7 +278,9 @@ impl Source {
         span: Option<&Range<usize>>,
         message: impl Into<String>,
     ) -> ModelError {
-        ModelError::new(kind, &self.file, message).at(span.map(|s| line_col(&self.text, s.start)))
+        let pos = span.map(|s| line_col(&self.text, s.start));
+        let e = ModelError::new(kind, &self.file, message).at(pos);
+        mark_set_line(e, &self.changed_lines)
     }
 
     fn element_pos(&self, name: &str) -> Option<(usize, usize)> {
@@ -174,9 +300,8 @@ impl Source {
             exprs.insert(k.clone(), v.clone());
         }
         let mut values: IndexMap<String, f64> = IndexMap::new();
-        let mut visiting: Vec<String> = Vec::new();
         for name in exprs.keys() {
-            self.eval_param(name, &exprs, &mut values, &mut visiting)?;
+            self.eval_param(name, &exprs, &mut values)?;
         }
         // keep file order
         let mut ordered = IndexMap::new();
@@ -188,37 +313,21 @@ impl Source {
         Ok(ordered)
     }
 
-    fn eval_param(
+    /// The parsed expression of parameter `name` and the names it uses.
+    fn parse_param(
         &self,
         name: &str,
         exprs: &IndexMap<String, RawValue>,
-        values: &mut IndexMap<String, f64>,
-        visiting: &mut Vec<String>,
-    ) -> Result<f64, ModelError> {
-        if let Some(v) = values.get(name) {
-            return Ok(*v);
-        }
+    ) -> Result<PendingParam, ModelError> {
         let raw = &exprs[name];
-        if visiting.iter().any(|v| v == name) {
-            return Err(self
-                .err(
-                    ErrorKind::BadParameter,
-                    Some(&raw.span),
-                    format!(
-                        "parameter `{name}` depends on itself: {} -> {name}",
-                        visiting.join(" -> ")
-                    ),
-                )
-                .hint("break the cycle: give one of these parameters a number"));
-        }
-        let e = match &raw.value {
+        let expr = match &raw.value {
             toml::Value::Float(v) => Expr::Num(*v),
             toml::Value::Integer(i) => Expr::Num(*i as f64),
             toml::Value::String(s) => Expr::parse(s).map_err(|e| {
                 self.err(
                     ErrorKind::BadParameter,
                     Some(&raw.span),
-                    format!("parameter `{name}` = \"{s}\": {e}"),
+                    format!("parameter `{name}` = \"{}\": {e}", clip(s)),
                 )
             })?,
             other => {
@@ -232,42 +341,86 @@ impl Source {
                 ));
             }
         };
-        visiting.push(name.to_owned());
-        let mut deps = HashMap::new();
-        for n in e.names() {
-            if n == "pi" {
+        Ok(PendingParam {
+            name: name.to_owned(),
+            names: expr.names(),
+            expr,
+            next: 0,
+        })
+    }
+
+    /// Evaluate parameter `root` and those it uses, depth first with an explicit stack (a
+    /// chain of 100 000 parameters must not overflow the call stack).
+    fn eval_param(
+        &self,
+        root: &str,
+        exprs: &IndexMap<String, RawValue>,
+        values: &mut IndexMap<String, f64>,
+    ) -> Result<(), ModelError> {
+        if values.contains_key(root) {
+            return Ok(());
+        }
+        let mut stack = vec![self.parse_param(root, exprs)?];
+        let mut on_stack: HashSet<String> = HashSet::from([root.to_owned()]);
+        while let Some(top) = stack.last_mut() {
+            if let Some(n) = top.names.get(top.next).cloned() {
+                top.next += 1;
+                if n == "pi" || values.contains_key(&n) {
+                    continue;
+                }
+                let name = &top.name;
+                if !exprs.contains_key(&n) {
+                    return Err(self
+                        .err(
+                            ErrorKind::BadParameter,
+                            Some(&exprs[name].span),
+                            format!(
+                                "parameter `{name}` uses `{}`, which is not a parameter",
+                                clip(&n)
+                            ),
+                        )
+                        .hint(format!(
+                            "parameters may only use numbers and other parameters; known: {}",
+                            clip(&exprs.keys().cloned().collect::<Vec<_>>().join(", "))
+                        )));
+                }
+                if on_stack.contains(&n) {
+                    let chain: Vec<&str> = stack.iter().map(|p| p.name.as_str()).collect();
+                    return Err(self
+                        .err(
+                            ErrorKind::BadParameter,
+                            Some(&exprs[&n].span),
+                            clip(&format!(
+                                "parameter `{n}` depends on itself: {} -> {n}",
+                                chain.join(" -> ")
+                            )),
+                        )
+                        .hint("break the cycle: give one of these parameters a number"));
+                }
+                on_stack.insert(n.clone());
+                let p = self.parse_param(&n, exprs)?;
+                stack.push(p);
                 continue;
             }
-            if !exprs.contains_key(&n) {
+            let Some(done) = stack.pop() else { break };
+            on_stack.remove(&done.name);
+            let span = &exprs[&done.name].span;
+            let v = done
+                .expr
+                .eval(&|n| values.get(n).copied())
+                .map_err(|m| self.err(ErrorKind::BadParameter, Some(span), m))?;
+            if !v.is_finite() {
                 return Err(self
                     .err(
                         ErrorKind::BadParameter,
-                        Some(&raw.span),
-                        format!("parameter `{name}` uses `{n}`, which is not a parameter"),
+                        Some(span),
+                        format!("parameter `{}` is {v}, which is not finite", done.name),
                     )
-                    .hint(format!(
-                        "parameters may only use numbers and other parameters; known: {}",
-                        exprs.keys().cloned().collect::<Vec<_>>().join(", ")
-                    )));
+                    .hint("check for division by zero, a negative square root or a typo"));
             }
-            let v = self.eval_param(&n, exprs, values, visiting)?;
-            deps.insert(n, v);
+            values.insert(done.name, v);
         }
-        visiting.pop();
-        let v = e
-            .eval(&|n| deps.get(n).copied())
-            .map_err(|m| self.err(ErrorKind::BadParameter, Some(&raw.span), m))?;
-        if !v.is_finite() {
-            return Err(self
-                .err(
-                    ErrorKind::BadParameter,
-                    Some(&raw.span),
-                    format!("parameter `{name}` is {v}, which is not finite"),
-                )
-                .hint("check for division by zero, a negative square root or a typo"));
-        }
-        values.insert(name.to_owned(), v);
-        Ok(v)
+        Ok(())
     }
 
     fn build_element(
@@ -297,7 +450,7 @@ impl Source {
             self.err(
                 ErrorKind::UnknownKind,
                 Some(&def.name_span),
-                format!("unknown element kind `{}`", def.kind),
+                format!("unknown element kind `{}`", clip(&def.kind)),
             )
             .element(&def.name)
             .hint(hint)
@@ -434,6 +587,8 @@ pub struct Model {
     pub checks: Vec<Check>,
     /// Named parameters and their values.
     pub parameters: IndexMap<String, f64>,
+    /// Notes from loading: things that load but were likely meant otherwise.
+    notes: Vec<ModelError>,
     source: Source,
 }
 
@@ -460,6 +615,8 @@ pub struct Inspection {
     pub order: Vec<(String, usize)>,
     /// Problems found.
     pub problems: Vec<ModelError>,
+    /// Notes: what loads but was likely meant otherwise ([`Model::notes`]).
+    pub notes: Vec<ModelError>,
 }
 
 struct Parsed {
@@ -483,6 +640,77 @@ fn syntax(file: &str, text: &str, e: &toml::de::Error) -> ModelError {
         .hint("a model has the sections title, description, [parameters], [elements], [bonds], [simulation], [initial], [[events]], [outputs], [[check]]")
 }
 
+/// The lines (1-based) of `after` that differ from those of `before`.
+fn changed_lines(before: &str, after: &str) -> Vec<usize> {
+    if before == after {
+        return Vec::new();
+    }
+    let old: Vec<&str> = before.lines().collect();
+    after
+        .lines()
+        .enumerate()
+        .filter(|(i, l)| old.get(*i) != Some(l))
+        .map(|(i, _)| i + 1)
+        .collect()
+}
+
+/// Say so when an error points at a line that `--set` wrote or changed.
+fn mark_set_line(mut e: ModelError, changed: &[usize]) -> ModelError {
+    if e.line.is_some_and(|l| changed.contains(&l)) {
+        e.message
+            .push_str(" (at a line written by --set: the file as changed by the overrides)");
+    }
+    e
+}
+
+/// Largest model file (and model text after `--set`), in bytes.
+pub const MAX_FILE_BYTES: usize = 16 << 20;
+
+/// Read a model file: at most [`MAX_FILE_BYTES`] (`/dev/zero` is refused, not read until
+/// memory runs out), UTF-8 (an invalid byte is named with its line, column and offset).
+fn read_model(path: &Path, file: &str) -> Result<String, ModelError> {
+    use std::io::Read;
+    let io = |e: std::io::Error| {
+        ModelError::new(ErrorKind::Io, file, format!("cannot read: {e}")).hint("check the path")
+    };
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(MAX_FILE_BYTES as u64 + 1).read_to_end(&mut bytes))
+        .map_err(io)?;
+    check_size(file, bytes.len())?;
+    String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let bytes = e.as_bytes();
+        let valid = std::str::from_utf8(&bytes[..at]).unwrap_or_default();
+        let pos = line_col(valid, valid.len());
+        ModelError::new(
+            ErrorKind::Syntax,
+            file,
+            format!(
+                "not UTF-8 text: the byte at offset {at} (0x{:02x}) is not valid UTF-8",
+                bytes.get(at).copied().unwrap_or(0)
+            ),
+        )
+        .at(Some(pos))
+        .hint("save the model as UTF-8")
+    })
+}
+
+fn check_size(file: &str, len: usize) -> Result<(), ModelError> {
+    if len > MAX_FILE_BYTES {
+        return Err(ModelError::new(
+            ErrorKind::Io,
+            file,
+            format!(
+                "is larger than {} MiB, the limit for a model file",
+                MAX_FILE_BYTES >> 20
+            ),
+        )
+        .hint("a model file is text of a few kB; is this the right file?"));
+    }
+    Ok(())
+}
+
 fn valid_name(n: &str) -> bool {
     let mut c = n.chars();
     c.next()
@@ -503,8 +731,13 @@ fn parse(
     registry: &Registry,
     overrides: &[String],
 ) -> Result<Parsed, ModelError> {
+    check_size(file, text.len())?;
+    let original = text;
     let text = crate::overrides::apply(file, text, overrides)?;
-    let spec: FileSpec = toml::from_str(&text).map_err(|e| syntax(file, &text, &e))?;
+    check_size(file, text.len())?;
+    let changed_lines = changed_lines(original, &text);
+    let spec: FileSpec = toml::from_str(&text)
+        .map_err(|e| mark_set_line(syntax(file, &text, &e), &changed_lines))?;
     if spec.elements.is_empty() {
         return Err(ModelError::new(ErrorKind::Syntax, file, "the model has no elements")
             .at(Some((1, 1)))
@@ -517,11 +750,12 @@ fn parse(
         param_exprs: IndexMap::new(),
         elements: Vec::new(),
         events: Vec::new(),
+        changed_lines,
     };
     for (k, v) in &spec.parameters {
         if !valid_name(k.get_ref()) || RESERVED.contains(&k.get_ref().as_str()) {
             return Err(source
-                .err(ErrorKind::BadParameter, Some(&k.span()), format!("`{}` cannot be a parameter name", k.get_ref()))
+                .err(ErrorKind::BadParameter, Some(&k.span()), format!("`{}` cannot be a parameter name", clip(k.get_ref())))
                 .hint("parameter names are letters, digits and _ (starting with a letter); `t`, `time` and `pi` are reserved"));
         }
         source.param_exprs.insert(k.get_ref().clone(), raw(v));
@@ -534,7 +768,7 @@ fn parse(
                 .err(
                     ErrorKind::Syntax,
                     Some(&name.span()),
-                    format!("`{n}` cannot be an element name"),
+                    format!("`{}` cannot be an element name", clip(n)),
                 )
                 .hint(
                     "element names are letters, digits and _ (starting with a letter), no dots",
@@ -653,7 +887,10 @@ fn build_graph(p: &mut Parsed) -> Result<BondGraph, ModelError> {
         let (a, b) = text.get_ref().split_once("->").ok_or_else(|| {
             err(
                 ErrorKind::Syntax,
-                format!("`{}` is not of the form \"from -> to\"", text.get_ref()),
+                format!(
+                    "`{}` is not of the form \"from -> to\"",
+                    clip(text.get_ref())
+                ),
             )
             .hint("the arrow points in the direction of positive power: \"source -> junction\"")
         })?;
@@ -787,14 +1024,10 @@ fn causal(p: &Parsed, g: BondGraph) -> Result<CausalGraph, ModelError> {
 pub fn inspect(path: &Path, registry: &Registry, overrides: &[String]) -> Inspection {
     let mut out = Inspection::default();
     let file = path.display().to_string();
-    let text = match std::fs::read_to_string(path) {
+    let text = match read_model(path, &file) {
         Ok(t) => t,
         Err(e) => {
-            out.problems.push(ModelError::new(
-                ErrorKind::Io,
-                &file,
-                format!("cannot read: {e}"),
-            ));
+            out.problems.push(e);
             return out;
         }
     };
@@ -852,8 +1085,9 @@ pub fn inspect(path: &Path, registry: &Registry, overrides: &[String]) -> Inspec
                 .map(|s| (s.name.clone(), s.initial))
                 .collect();
             out.order = eqs.order();
-            if let Err(e) = finish(p, eqs) {
-                out.problems.push(e);
+            match finish(p, eqs) {
+                Ok(m) => out.notes = m.notes(),
+                Err(e) => out.problems.push(e),
             }
         }
         Err(e) => out.problems.push(core_error(&p.source, e)),
@@ -939,7 +1173,7 @@ fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
                 .err(
                     ErrorKind::Settings,
                     Some(&s.span()),
-                    format!("unknown solver `{}`", s.get_ref()),
+                    format!("unknown solver `{}`", clip(s.get_ref())),
                 )
                 .hint(format!("solvers: {}", Method::names()))
         })?;
@@ -963,31 +1197,7 @@ fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
             )
             .hint("t_start < t_end, dt_out > 0, 0 < rtol < 1, atol > 0"));
     }
-    // outputs
-    let mut outputs = Vec::new();
-    if spec.outputs.is_empty() {
-        for (i, s) in eqs.states().iter().enumerate() {
-            outputs.push(Output {
-                name: s.name.clone(),
-                probe: bondgraph::Probe::State(i),
-            });
-        }
-    }
-    for (col, name) in &spec.outputs {
-        let probe = eqs.probe(name.get_ref()).ok_or_else(|| {
-            let el = name.get_ref().split('.').next().unwrap_or("");
-            let offers: Vec<String> = eqs.probe_names().into_iter().filter(|n| n.starts_with(&format!("{el}."))).take(16).collect();
-            source.err(ErrorKind::Settings, Some(&name.span()), format!("[outputs] `{}`: nothing is called `{}`", col.get_ref(), name.get_ref())).hint(if offers.is_empty() {
-                "outputs name a state (`mass.p`), its derivative (`mass.p.dot`), a signal (`ctrl.out`) or a bond variable (`mass.e`, `mass.f`, `b3.P`, `lever.2.e`)".to_owned()
-            } else {
-                format!("`{el}` offers: {}", offers.join(", "))
-            })
-        })?;
-        outputs.push(Output {
-            name: col.get_ref().clone(),
-            probe,
-        });
-    }
+    let (outputs, notes) = read_outputs(&spec.outputs, &source, &eqs)?;
     // checks
     let mut checks = Vec::new();
     for c in &spec.check {
@@ -998,7 +1208,7 @@ fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
                 source.err(
                     ErrorKind::Settings,
                     Some(&span),
-                    format!("[[check]] {what} = \"{}\": {e}", text.get_ref()),
+                    format!("[[check]] {what} = \"{}\": {e}", clip(text.get_ref())),
                 )
             })?;
             for n in e.names() {
@@ -1041,11 +1251,117 @@ fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
         outputs,
         checks,
         parameters,
+        notes,
         source,
     };
     // events must build now, so that their errors show at load time
     model.events()?;
     Ok(model)
+}
+
+/// Longest output column name, in characters.
+pub const MAX_COLUMN_NAME: usize = 100;
+
+/// Whether `n` may name an output column: 1 to [`MAX_COLUMN_NAME`] characters, letters,
+/// digits, `_`, `.`, `[`, `]`, starting with a letter or `_`; not `t`, `time` or `pi`. Such a
+/// name needs no quoting in a CSV header and can be used in a `[[check]]`.
+#[must_use]
+pub fn valid_column_name(n: &str) -> bool {
+    let mut c = n.chars();
+    n.chars().count() <= MAX_COLUMN_NAME
+        && !RESERVED.contains(&n)
+        && c.next()
+            .is_some_and(|f| f.is_ascii_alphabetic() || f == '_')
+        && c.all(|ch| ch.is_ascii_alphanumeric() || "_.[]".contains(ch))
+}
+
+/// `[outputs]` as columns (every state if the section is absent), and notes on outputs that
+/// likely meant another variable: `p_hose = "hose.P"` reads the power, next to `hose.p`, the
+/// pressure (a column whose name starts with `P` or says `power` is taken to mean a power).
+fn read_outputs(
+    spec: &SpannedMap<String>,
+    source: &Source,
+    eqs: &StateEquations,
+) -> Result<(Vec<Output>, Vec<ModelError>), ModelError> {
+    let mut outputs = Vec::new();
+    let mut notes = Vec::new();
+    if spec.is_empty() {
+        for (i, s) in eqs.states().iter().enumerate() {
+            outputs.push(Output {
+                name: s.name.clone(),
+                probe: bondgraph::Probe::State(i),
+            });
+        }
+        return Ok((outputs, notes));
+    }
+    let names = eqs.probe_names();
+    for (col, name) in spec {
+        if !valid_column_name(col.get_ref()) {
+            return Err(source
+                .err(
+                    ErrorKind::Settings,
+                    Some(&col.span()),
+                    format!("[outputs] `{}` cannot be a column name", clip(col.get_ref())),
+                )
+                .hint(format!("column names are 1 to {MAX_COLUMN_NAME} letters, digits, `_`, `.`, `[`, `]`, starting with a letter or `_`; `t` is the first column already, `time` and `pi` are reserved")));
+        }
+        let probe = eqs.probe(name.get_ref()).ok_or_else(|| {
+            let el = name.get_ref().split('.').next().unwrap_or("");
+            let offers: Vec<&String> = names
+                .iter()
+                .filter(|n| n.starts_with(&format!("{el}.")))
+                .take(16)
+                .collect();
+            let offers: Vec<&str> = offers.iter().map(|s| s.as_str()).collect();
+            source.err(ErrorKind::Settings, Some(&name.span()), format!("[outputs] `{}`: nothing is called `{}`", col.get_ref(), clip(name.get_ref()))).hint(if offers.is_empty() {
+                "outputs name a state (`mass.p`), its derivative (`mass.p.dot`), a signal (`ctrl.out`) or a bond variable (`mass.e`, `mass.f`, `b3.P`, `lever.2.e`)".to_owned()
+            } else {
+                format!("`{}` offers: {}", clip(el), offers.join(", "))
+            })
+        })?;
+        // A power read into a column whose name does not say so (or the reverse), where a
+        // variable differing only in case exists: likely the other was meant.
+        let col_says_power =
+            col.get_ref().starts_with('P') || col.get_ref().to_ascii_lowercase().contains("power");
+        let is_power = matches!(probe, bondgraph::Probe::Power(_));
+        let other = names
+            .iter()
+            .find(|n| *n != name.get_ref() && n.eq_ignore_ascii_case(name.get_ref()));
+        if let Some(other) = other.filter(|_| col_says_power != is_power) {
+            let what = |p: Option<bondgraph::Probe>| match p {
+                Some(bondgraph::Probe::State(_)) => "a state",
+                Some(bondgraph::Probe::Derivative(_)) => "a state's derivative",
+                Some(bondgraph::Probe::Effort(_)) => "an effort",
+                Some(bondgraph::Probe::Flow(_)) => "a flow",
+                Some(bondgraph::Probe::Signal(_)) => "a signal",
+                Some(bondgraph::Probe::Power(_)) => "a power (e·f)",
+                _ => "a variable",
+            };
+            notes.push(
+                source
+                    .err(
+                        ErrorKind::Settings,
+                        Some(&name.span()),
+                        format!(
+                            "[outputs] `{}` reads `{}`, {}; `{other}` is {}: names differ in case",
+                            col.get_ref(),
+                            name.get_ref(),
+                            what(Some(probe)),
+                            what(eqs.probe(other))
+                        ),
+                    )
+                    .hint(format!(
+                        "if you meant {}, write `{other}`",
+                        what(eqs.probe(other))
+                    )),
+            );
+        }
+        outputs.push(Output {
+            name: col.get_ref().clone(),
+            probe,
+        });
+    }
+    Ok((outputs, notes))
 }
 
 fn flatten(
@@ -1087,10 +1403,7 @@ impl Model {
         overrides: &[String],
     ) -> Result<Self, ModelError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| {
-            ModelError::new(ErrorKind::Io, &file, format!("cannot read: {e}"))
-                .hint("check the path")
-        })?;
+        let text = read_model(path, &file)?;
         Self::from_text(&file, &text, registry, overrides)
     }
 
@@ -1112,6 +1425,33 @@ impl Model {
     #[must_use]
     pub fn file(&self) -> &str {
         &self.source.file
+    }
+
+    /// What loads but was likely meant otherwise, for the current settings: an output that
+    /// differs only in case from another variable, events before `t_start` (applied at the
+    /// start) or after `t_end` (not reached).
+    #[must_use]
+    pub fn notes(&self) -> Vec<ModelError> {
+        let mut notes = self.notes.clone();
+        let s = &self.settings;
+        for ev in &self.source.events {
+            let when = if ev.t < s.t_start {
+                format!(
+                    "before t_start = {} s: it is applied at the start",
+                    s.t_start
+                )
+            } else if ev.t > s.t_end {
+                format!("after t_end = {} s: it is not reached", s.t_end)
+            } else {
+                continue;
+            };
+            notes.push(self.source.err(
+                ErrorKind::Settings,
+                Some(&ev.span),
+                format!("the event at t = {} s is {when}", ev.t),
+            ));
+        }
+        notes
     }
 
     /// 1-based line where element `name` is defined.
@@ -1174,15 +1514,59 @@ impl Model {
         Ok(events)
     }
 
-    /// Run the model with its settings; the elements are restored afterwards, so the model
-    /// can run again.
+    /// Run the model with its settings and keep the rows in memory; the elements are
+    /// restored afterwards, so the model can run again. The rows are bounded
+    /// ([`bondgraph::MAX_VALUES_IN_MEMORY`]); [`Model::run_into`] streams them instead.
     pub fn run(&mut self) -> Result<bondgraph::Outcome, ModelError> {
+        self.run_events(|eqs, x0, s, outputs, events| {
+            bondgraph::simulate(eqs, x0, s, outputs, events)
+        })
+    }
+
+    /// Run the model, handing each output row to `sink` as it is computed, and evaluate the
+    /// `[[check]]`s at every output row and every accepted solver step (a check must hold
+    /// between the rows too). The elements are restored afterwards.
+    pub fn run_into(
+        &mut self,
+        sink: &mut dyn bondgraph::RowSink,
+    ) -> Result<(bondgraph::Outcome, Vec<CheckResult>), ModelError> {
+        let mut checker = CheckSink::new(self, sink)?;
+        let out = self.run_events(|eqs, x0, s, outputs, events| {
+            bondgraph::simulate_into(eqs, x0, s, outputs, events, &mut checker)
+        })?;
+        let results = checker.results(&self.checks);
+        Ok((out, results))
+    }
+
+    /// [`Model::run_into`] keeping the rows in memory (in `trajectory.rows`), bounded as
+    /// [`Model::run`].
+    pub fn run_checked(&mut self) -> Result<(bondgraph::Outcome, Vec<CheckResult>), ModelError> {
+        bondgraph::check_in_memory(&self.settings, self.outputs.len() + 1).map_err(|e| {
+            self.source
+                .err(ErrorKind::Settings, None, format!("[simulation] {e}"))
+        })?;
+        let mut rows: Vec<Vec<f64>> = Vec::new();
+        let (mut out, checks) = self.run_into(&mut rows)?;
+        out.trajectory.rows = rows;
+        Ok((out, checks))
+    }
+
+    /// Run `simulate` with the model's events, then restore the elements the events replaced.
+    fn run_events(
+        &mut self,
+        simulate: impl FnOnce(
+            &mut StateEquations,
+            &[f64],
+            &Settings,
+            &[Output],
+            Vec<Event>,
+        ) -> bondgraph::Outcome,
+    ) -> Result<bondgraph::Outcome, ModelError> {
         let events = self.events()?;
         let has_events = !events.is_empty();
-        let x0 = self.x0.clone();
-        let out = bondgraph::simulate(
+        let out = simulate(
             &mut self.equations,
-            &x0,
+            &self.x0,
             &self.settings,
             &self.outputs,
             events,
@@ -1200,14 +1584,14 @@ impl Model {
         Ok(out)
     }
 
-    /// Compare a trajectory with the model's `[[check]]`s.
+    /// Compare a trajectory with the model's `[[check]]`s at its output rows only (a sample:
+    /// [`Model::run_into`] checks every accepted step too).
     #[must_use]
     pub fn verify(&self, traj: &bondgraph::Trajectory) -> Vec<CheckResult> {
         self.checks
             .iter()
             .map(|c| {
-                let mut worst = (0.0f64, f64::NAN);
-                let mut finite = !traj.rows.is_empty();
+                let mut worst = Worst::NONE;
                 for row in &traj.rows {
                     let t = row[0];
                     let lookup = |n: &str| {
@@ -1223,20 +1607,9 @@ impl Model {
                         (Ok(v), Ok(e)) => (v - e).abs(),
                         _ => f64::NAN,
                     };
-                    if !err.is_finite() {
-                        finite = false;
-                    }
-                    if err > worst.0 || worst.1.is_nan() {
-                        worst = (err, t);
-                    }
+                    worst.add(t, err);
                 }
-                CheckResult {
-                    value: c.value.clone(),
-                    max_error: worst.0,
-                    t_worst: worst.1,
-                    tol: c.tol,
-                    passed: finite && worst.0 <= c.tol,
-                }
+                worst.result(c, traj.rows.len(), false)
             })
             .collect()
     }

@@ -3,11 +3,32 @@
 //! The key is a dotted TOML path (`parameters.k`, `simulation.t_end`, `elements.mass.m`);
 //! the value is read as TOML (`2.5`, `"bdf"`, `[1, 2]`, `true`) or, failing that, taken as a
 //! string (so `--set elements.spring.c=1/k` sets an expression). The document keeps its
-//! layout, so errors still point at the right lines.
+//! layout, so errors still point at the right lines. A segment may be quoted
+//! (`initial."spring.q"`), a key with dots written in quotes in the file is found as one key
+//! (`initial.spring.q` sets `"spring.q"`), and `name[k]` addresses entry k of a list
+//! (`events[0].t`, `check[1].tol`). Sections and `[simulation]` keys the format does not
+//! have are refused here, not later at a line the user never wrote.
 
 use toml_edit::{DocumentMut, Item, Value};
 
-use crate::error::{ErrorKind, ModelError};
+use crate::error::{clip, ErrorKind, ModelError};
+
+/// The sections of a model file, and the keys of those with fixed keys.
+const SECTIONS: &[&str] = &[
+    "title",
+    "description",
+    "parameters",
+    "elements",
+    "bonds",
+    "simulation",
+    "initial",
+    "events",
+    "outputs",
+    "check",
+];
+const SIMULATION_KEYS: &[&str] = &["t_start", "t_end", "dt_out", "solver", "rtol", "atol"];
+const EVENT_KEYS: &[&str] = &["t", "set"];
+const CHECK_KEYS: &[&str] = &["value", "expected", "tol"];
 
 /// Apply `overrides` (`key=value` strings) to the TOML `text`.
 pub fn apply(file: &str, text: &str, overrides: &[String]) -> Result<String, ModelError> {
@@ -18,14 +39,13 @@ pub fn apply(file: &str, text: &str, overrides: &[String]) -> Result<String, Mod
         ModelError::new(ErrorKind::Syntax, file, e.message().to_owned())
     })?;
     for o in overrides {
-        let err = |m: String| ModelError::new(ErrorKind::Override, file, format!("--set {o}: {m}"));
+        let err = |m: String| {
+            ModelError::new(ErrorKind::Override, file, format!("--set {}: {m}", clip(o)))
+        };
         let (key, value) = o
             .split_once('=')
             .ok_or_else(|| err("expected key=value".into()))?;
-        let path: Vec<&str> = key.trim().split('.').collect();
-        if path.iter().any(|p| p.is_empty()) {
-            return Err(err("empty key segment".into()));
-        }
+        let path = split_key(key.trim()).map_err(err)?;
         let value = parse_value(value.trim());
         set_path(doc.as_item_mut(), &path, 0, value).map_err(|(m, hint)| {
             let e = err(m);
@@ -38,55 +58,240 @@ pub fn apply(file: &str, text: &str, overrides: &[String]) -> Result<String, Mod
     Ok(doc.to_string())
 }
 
+/// One segment of a `--set` key: a key, with an array index if written `name[k]`.
+#[derive(Clone, Debug, PartialEq)]
+struct Segment {
+    key: String,
+    /// `name[k]`: entry k of the array `name` (if `name` is an array; else the key is
+    /// `name[k]` itself, as in `[initial] "arm.q[1]"`).
+    index: Option<usize>,
+    /// The segment was quoted: never an array index, never split.
+    quoted: bool,
+}
+
+impl Segment {
+    /// The segment as written, for messages and literal keys.
+    fn literal(&self) -> String {
+        match self.index {
+            Some(k) if !self.quoted => format!("{}[{k}]", self.key),
+            _ => self.key.clone(),
+        }
+    }
+}
+
+/// Split a dotted key: `a.b`, `initial."spring.q"`, `events[0].t`.
+fn split_key(key: &str) -> Result<Vec<Segment>, String> {
+    let mut out = Vec::new();
+    let mut chars = key.chars().peekable();
+    loop {
+        let mut seg = String::new();
+        let mut quoted = false;
+        if let Some(&q @ ('"' | '\'')) = chars.peek() {
+            chars.next();
+            quoted = true;
+            loop {
+                match chars.next() {
+                    Some(c) if c == q => break,
+                    Some(c) => seg.push(c),
+                    None => return Err(format!("unclosed {q} in the key")),
+                }
+            }
+        } else {
+            while let Some(&c) = chars.peek() {
+                if c == '.' {
+                    break;
+                }
+                seg.push(c);
+                chars.next();
+            }
+        }
+        let seg = seg.trim().to_owned();
+        if seg.is_empty() {
+            return Err("empty key segment".into());
+        }
+        let index = if quoted {
+            None
+        } else {
+            seg.strip_suffix(']')
+                .and_then(|s| s.rsplit_once('['))
+                .and_then(|(_, k)| k.parse::<usize>().ok())
+        };
+        let key = match index {
+            Some(_) => seg[..seg.rfind('[').unwrap_or(seg.len())].to_owned(),
+            None => seg,
+        };
+        out.push(Segment { key, index, quoted });
+        match chars.next() {
+            None => return Ok(out),
+            Some('.') => {}
+            Some(c) => return Err(format!("unexpected `{c}` after a quoted key segment")),
+        }
+    }
+}
+
 type SetError = (String, Option<String>);
 
-fn set_path(item: &mut Item, path: &[&str], i: usize, value: Value) -> Result<(), SetError> {
-    let seg = path[i];
+/// The keys `path` may create where the format has fixed keys (`None`: any key).
+fn allowed_keys(path: &[Segment], i: usize) -> Option<&'static [&'static str]> {
+    match (i, path.first().map(|s| s.key.as_str())) {
+        (0, _) => Some(SECTIONS),
+        (1, Some("simulation")) => Some(SIMULATION_KEYS),
+        (1, Some("events")) => Some(EVENT_KEYS),
+        (1, Some("check")) => Some(CHECK_KEYS),
+        _ => None,
+    }
+}
+
+fn set_path(item: &mut Item, path: &[Segment], i: usize, value: Value) -> Result<(), SetError> {
+    let written = |upto: usize| {
+        path[..upto]
+            .iter()
+            .map(Segment::literal)
+            .collect::<Vec<_>>()
+            .join(".")
+    };
     let table = item
         .as_table_like_mut()
-        .ok_or_else(|| (format!("`{}` is not a table", path[..i].join(".")), None))?;
-    let exists = table.get(seg).is_some();
+        .ok_or_else(|| (format!("`{}` is not a table", written(i)), None))?;
+    // A key with dots, quoted in the file (`[initial] "spring.q" = 0.1`), is set as one key.
+    if path.len() > i + 1 && path[i..].iter().all(|s| s.index.is_none()) {
+        let joined = path[i..]
+            .iter()
+            .map(|s| s.key.as_str())
+            .collect::<Vec<_>>()
+            .join(".");
+        if let Some(old) = table.get(&joined).and_then(Item::as_value) {
+            let mut value = value;
+            *value.decor_mut() = old.decor().clone();
+            table.insert(&joined, Item::Value(value));
+            return Ok(());
+        }
+    }
+    let seg = &path[i];
+    // `name[k]`: an entry of an array (events[0], check[1]), if `name` is one
+    let is_array = table
+        .get(&seg.key)
+        .is_some_and(|it| it.is_array_of_tables() || it.is_array());
+    if let (Some(k), true) = (seg.index, is_array) {
+        let Some(arr) = table.get_mut(&seg.key) else {
+            return Err((format!("no `{}`", seg.key), None));
+        };
+        let len = arr
+            .as_array_of_tables()
+            .map(toml_edit::ArrayOfTables::len)
+            .or_else(|| arr.as_array().map(toml_edit::Array::len))
+            .unwrap_or(0);
+        if k >= len {
+            return Err((
+                format!(
+                    "`{}` has {len} entries, so there is no `{}`",
+                    seg.key,
+                    seg.literal()
+                ),
+                Some(format!(
+                    "entries are numbered from 0: {}[0] to {}[{}]",
+                    seg.key,
+                    seg.key,
+                    len.saturating_sub(1)
+                )),
+            ));
+        }
+        if i + 1 == path.len() {
+            if let Some(a) = arr.as_array_mut() {
+                a.replace(k, value);
+                return Ok(());
+            }
+            return Err((
+                format!("`{}` is a table: set one of its keys", seg.literal()),
+                None,
+            ));
+        }
+        if let Some(t) = arr.as_array_of_tables_mut().and_then(|a| a.get_mut(k)) {
+            let mut item = Item::Table(std::mem::take(t));
+            let r = set_path(&mut item, path, i + 1, value);
+            if let Item::Table(back) = item {
+                *t = back;
+            }
+            return r;
+        }
+        return Err((format!("`{}` is not a table", seg.literal()), None));
+    }
+    if is_array && !seg.quoted {
+        let len = table
+            .get(&seg.key)
+            .and_then(|it| it.as_array_of_tables().map(toml_edit::ArrayOfTables::len))
+            .unwrap_or(0);
+        if len > 0 && i + 1 < path.len() {
+            return Err((
+                format!("`{}` is a list of {len}: name the entry", written(i + 1)),
+                Some(format!(
+                    "write `{}[0].{}`",
+                    written(i + 1),
+                    path[i + 1..]
+                        .iter()
+                        .map(Segment::literal)
+                        .collect::<Vec<_>>()
+                        .join(".")
+                )),
+            ));
+        }
+    }
+    let key = seg.literal();
+    let exists = table.get(&key).is_some();
+    if !exists {
+        if let Some(allowed) = allowed_keys(path, i).filter(|a| !a.contains(&key.as_str())) {
+            let what = if i == 0 {
+                "the model file format has no section".to_owned()
+            } else {
+                format!("`{}` has no key", written(i))
+            };
+            return Err((
+                format!("{what} `{key}`"),
+                Some(format!("the keys are: {}", allowed.join(", "))),
+            ));
+        }
+    }
     if i + 1 == path.len() {
         // New keys are allowed only where the file format has optional keys.
-        if !exists && path[0] == "parameters" {
+        if !exists && path[0].key == "parameters" {
             let known: Vec<String> = table.iter().map(|(k, _)| k.to_owned()).collect();
             return Err((
-                format!("the model has no parameter `{seg}`"),
+                format!("the model has no parameter `{key}`"),
                 Some(format!("parameters are: {}", known.join(", "))),
             ));
         }
-        if !exists && path[0] == "elements" && path.len() == 2 {
+        if !exists && path[0].key == "elements" && path.len() == 2 {
             return Err((
-                format!("the model has no element `{seg}`"),
+                format!("the model has no element `{key}`"),
                 Some(known_keys(table)),
             ));
         }
         let mut value = value;
-        if let Some(old) = table.get(seg).and_then(Item::as_value) {
+        if let Some(old) = table.get(&key).and_then(Item::as_value) {
             // keep the comment and spacing around the old value
             *value.decor_mut() = old.decor().clone();
         }
-        table.insert(seg, Item::Value(value));
+        table.insert(&key, Item::Value(value));
         return Ok(());
     }
     if !exists {
-        if path[0] == "elements" && i == 1 {
+        if path[0].key == "elements" && i == 1 {
             return Err((
-                format!("the model has no element `{seg}`"),
+                format!("the model has no element `{key}`"),
                 Some(known_keys(table)),
             ));
         }
-        table.insert(seg, Item::Table(toml_edit::Table::new()));
+        table.insert(&key, Item::Table(toml_edit::Table::new()));
     }
     let next = table
-        .get_mut(seg)
-        .ok_or_else(|| (format!("no `{seg}`"), None))?;
+        .get_mut(&key)
+        .ok_or_else(|| (format!("no `{key}`"), None))?;
     set_path(next, path, i + 1, value)
 }
 
 fn known_keys(table: &dyn toml_edit::TableLike) -> String {
     let keys: Vec<&str> = table.iter().map(|(k, _)| k).collect();
-    format!("it has: {}", keys.join(", "))
+    format!("it has: {}", clip(&keys.join(", ")))
 }
 
 fn parse_value(s: &str) -> Value {

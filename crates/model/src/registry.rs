@@ -264,7 +264,7 @@ impl ElementSpec<'_> {
             toml::Value::Float(v) => Ok(Expr::Num(*v)),
             toml::Value::Integer(i) => Ok(Expr::Num(*i as f64)),
             toml::Value::String(s) => Expr::parse(s).map_err(|e| {
-                self.error(key, ErrorKind::BadParameter, format!("cannot read `{key}` = \"{s}\": {e}"))
+                self.error(key, ErrorKind::BadParameter, format!("cannot read `{key}` = \"{}\": {e}", crate::error::clip(s)))
                     .hint("expressions use numbers, parameters, signals like `spring.q`, `t`, + - * / ^ and functions such as sqrt, sin, exp, min, max")
             }),
             other => Err(self.error(key, ErrorKind::BadParameter, format!("`{key}` must be a number or an expression string, not {}", other.type_str()))),

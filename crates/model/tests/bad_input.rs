@@ -1327,3 +1327,282 @@ fn negative_constant_expression_for_a_resistance() {
         &["-0.5"],
     );
 }
+
+// ---- Issue "hardening": hostile input ----
+
+/// #1: 9 000 nested parentheses, 15 800 minus signs or a 52 000-term sum in one parameter
+/// overflowed the stack (abort, exit 134). Refused, naming the parameter, on a small stack.
+#[test]
+fn deeply_nested_parameter_expressions_are_refused_not_a_stack_overflow() {
+    let values = [
+        format!("{}10{}", "(".repeat(9000), ")".repeat(9000)),
+        format!("{}10", "-".repeat(15_800)),
+        vec!["1"; 52_000].join("+"),
+    ];
+    let errors = std::thread::Builder::new()
+        .stack_size(512 * 1024)
+        .spawn(move || {
+            values
+                .iter()
+                .map(|v| error_with(MSD, &[&format!("parameters.k={v}")]))
+                .collect::<Vec<_>>()
+        })
+        .unwrap()
+        .join()
+        .unwrap();
+    for e in &errors {
+        check(e, ErrorKind::BadParameter, None, &["parameter `k`"]);
+        assert!(
+            e.message.contains("nested more than 200") || e.message.contains("more than 10000"),
+            "{e}"
+        );
+        assert!(
+            e.to_string().len() < 600,
+            "the value is not echoed whole: {e}"
+        );
+    }
+}
+
+/// #1: a chain of 100 000 parameters, each using the one before, was evaluated recursively.
+#[test]
+fn a_long_chain_of_parameters_does_not_overflow_the_stack() {
+    let mut text = String::from("[parameters]\np0 = 1.0\n");
+    for i in 1..100_000 {
+        text.push_str(&format!("p{i} = \"p{} + 1\"\n", i - 1));
+    }
+    text.push_str("[elements]\nmass = { kind = \"I\", m = \"p99999\" }\nsrc = { kind = \"Se\", e = 1.0 }\n[bonds]\nb = \"src -> mass\"\n");
+    let m = std::thread::Builder::new()
+        .stack_size(512 * 1024)
+        .spawn(move || load(&text).map(|m| m.parameters["p99999"]))
+        .unwrap()
+        .join()
+        .unwrap()
+        .unwrap();
+    assert!((m - 100_000.0).abs() < 1e-9);
+}
+
+/// #7: `bg-sim check /dev/zero` read until memory ran out. Files are read up to 16 MiB.
+#[test]
+fn a_file_larger_than_the_limit_is_refused_without_reading_it_all() {
+    let e = Model::load(
+        std::path::Path::new("/dev/zero"),
+        &Registry::with_core(),
+        &[],
+    )
+    .unwrap_err();
+    assert_eq!(e.kind, ErrorKind::Io, "{e}");
+    assert!(e.message.contains("larger than 16 MiB"), "{e}");
+}
+
+/// #10: invalid UTF-8 was refused without saying where.
+#[test]
+fn invalid_utf8_is_refused_with_its_position() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("latin1.toml");
+    let mut bytes = b"title = \"ok\"\n[parameters]\nm = 1.0 # caf".to_vec();
+    bytes.push(0xe9);
+    bytes.extend_from_slice(b"\n");
+    std::fs::write(&path, &bytes).unwrap();
+    let e = Model::load(&path, &Registry::with_core(), &[]).unwrap_err();
+    assert_eq!(e.kind, ErrorKind::Syntax, "{e}");
+    assert!(e.message.contains("offset 39 (0xe9)"), "{e}");
+    assert_eq!((e.line, e.col), (Some(3), Some(14)), "{e}");
+}
+
+/// #10: refusals echoed the whole offending value (10 MB on stderr).
+#[test]
+fn refusals_cut_long_values() {
+    let long = "x".repeat(1_000_000);
+    for set in [
+        format!("simulation.solver={long}"),
+        format!("elements.mass.kind={long}"),
+        format!("parameters.k=\"{}\"", "1".repeat(20_000)),
+        format!("{long}=1"),
+    ] {
+        let e = error_with(MSD, &[&set]);
+        assert!(
+            e.to_string().len() < 3_000,
+            "{} characters: {}",
+            e.to_string().len(),
+            &e.to_string()[..300]
+        );
+        assert!(e.to_string().contains("more characters"), "{e}");
+    }
+}
+
+/// #2: an output named `"a,b"` gave a CSV header of 11 fields over rows of 10; a newline, a
+/// quote, an empty name or a second `t` column were accepted too.
+#[test]
+fn output_column_names_must_be_plain() {
+    for name in [
+        "\"a,b\"",
+        "\"a\\nb\"",
+        "\"a\\\"b\"",
+        "\"\"",
+        "t",
+        "time",
+        "pi",
+        "\"a b\"",
+        &"x".repeat(101),
+    ] {
+        let text = msd_replacing("x = ", &format!("{name} = \"spring.q\""));
+        let e = error(&text);
+        check(
+            &e,
+            ErrorKind::Settings,
+            None,
+            &["[outputs]", "cannot be a column name"],
+        );
+        hint(&e, &["letters, digits"]);
+        assert_eq!(e.line, Some(line_of(&text, "\"spring.q\"")), "{e}");
+    }
+    for ok in ["x_1", "arm.q[1]", "_p"] {
+        let text = msd_replacing("x = ", &format!("\"{ok}\" = \"spring.q\""));
+        load(&text).unwrap_or_else(|e| panic!("{ok}: {e}"));
+    }
+}
+
+/// #10: `hose.P` (power) next to `hose.p` (pressure) gave no hint; here `mass.P` (the power
+/// of the mass's bond) next to `mass.p` (its momentum).
+#[test]
+fn an_output_differing_only_in_case_from_another_variable_gets_a_note() {
+    let m = load(&msd_replacing("x = ", "x = \"mass.P\"")).unwrap();
+    let notes = m.notes();
+    assert_eq!(notes.len(), 1, "{notes:?}");
+    let n = notes[0].to_string();
+    assert!(
+        n.contains("`mass.P`, a power") && n.contains("`mass.p` is a state"),
+        "{n}"
+    );
+    assert!(load(MSD).unwrap().notes().is_empty());
+    // a column that says it is a power, or a momentum in a column that does not: no note
+    for fine in [
+        "P_mass = \"mass.P\"",
+        "mass_power = \"mass.P\"",
+        "x = \"mass.p\"",
+    ] {
+        let m = load(&msd_replacing("x = ", fine)).unwrap();
+        assert!(m.notes().is_empty(), "{fine}: {:?}", m.notes());
+    }
+    // the momentum read into a column named as a power
+    let m = load(&msd_replacing("x = ", "P_mass = \"mass.p\"")).unwrap();
+    assert_eq!(m.notes().len(), 1);
+}
+
+/// #4: events before t_start were applied at t_start and events after t_end dropped, silently.
+#[test]
+fn events_outside_the_run_get_notes() {
+    let text = msd_plus("[[events]]\nt = 5.0\nset = { c = 0.0 }\n");
+    let m = load(&text).unwrap();
+    let notes = m.notes();
+    assert_eq!(notes.len(), 1, "{notes:?}");
+    assert!(
+        notes[0]
+            .message
+            .contains("after t_end = 1 s: it is not reached"),
+        "{}",
+        notes[0]
+    );
+    assert_eq!(notes[0].line, Some(line_of(&text, "[[events]]")));
+    let m = load_with(&text, &["simulation.t_start=6", "simulation.t_end=7"]).unwrap();
+    assert!(m.notes()[0]
+        .message
+        .contains("before t_start = 6 s: it is applied at the start"));
+    let m = load_with(&text, &["simulation.t_end=7"]).unwrap();
+    assert!(m.notes().is_empty());
+}
+
+/// #4: `rtol = 1e-300` was accepted; so were times too large to resolve.
+#[test]
+fn tolerances_and_times_beyond_f64_resolution_are_refused() {
+    for (set, key) in [
+        ("simulation.rtol=1e-300", "rtol"),
+        ("simulation.t_start=1e16", "t_end"),
+    ] {
+        let e = error_with(
+            MSD,
+            &[
+                set,
+                "simulation.t_end=1.00000000000001e16",
+                "simulation.dt_out=1",
+            ][..if key == "rtol" { 1 } else { 3 }],
+        );
+        check(&e, ErrorKind::Settings, None, &[key]);
+    }
+}
+
+/// #10: `[initial]` keys with dots could not be set by `--set`.
+#[test]
+#[allow(clippy::float_cmp)] // values copied from the file: exact
+fn initial_keys_with_dots_can_be_set() {
+    let text = msd_plus("[initial]\n\"spring.q\" = 0.02\n");
+    let q = |m: &Model| {
+        m.x0[m
+            .equations
+            .states()
+            .iter()
+            .position(|s| s.name == "spring.q")
+            .unwrap()]
+    };
+    assert_eq!(q(&load(&text).unwrap()), 0.02);
+    assert_eq!(
+        q(&load_with(&text, &["initial.spring.q=0.03"]).unwrap()),
+        0.03
+    );
+    assert_eq!(
+        q(&load_with(&text, &["initial.\"spring.q\"=0.04"]).unwrap()),
+        0.04
+    );
+    assert_eq!(
+        q(&load_with(MSD, &["initial.\"spring.q\"=0.05"]).unwrap()),
+        0.05
+    );
+}
+
+/// #10: list entries (`events[0].t`) could not be addressed, and the error pointed at a line
+/// the user never wrote (a new `[events[0]]` table at the end of the file).
+#[test]
+#[allow(clippy::float_cmp)] // values copied from the file: exact
+fn list_entries_can_be_set_and_unknown_keys_are_refused_at_the_set() {
+    let text = msd_plus("[[events]]\nt = 0.5\nset = { c = 0.0 }\n\n[[check]]\nvalue = \"x\"\nexpected = \"0\"\ntol = 1.0\n");
+    let m = load_with(
+        &text,
+        &["events[0].t=0.25", "check[0].tol=2", "events[0].set.c=0.1"],
+    )
+    .unwrap();
+    assert_eq!(m.checks[0].tol, 2.0);
+    assert!(m.notes().is_empty());
+    let ev = m.events().unwrap();
+    assert_eq!(ev[0].t, 0.25);
+    for (set, mentions, hint_mentions) in [
+        ("events[3].t=1", "has 1 entries", "events[0] to events[0]"),
+        ("events.t=1", "is a list of 1", "events[0].t"),
+        (
+            "simulation.tend=5",
+            "`simulation` has no key `tend`",
+            "t_end",
+        ),
+        ("event.t=1", "no section `event`", "events"),
+        ("check[0].tolerance=1", "has no key `tolerance`", "tol"),
+    ] {
+        let e = error_with(&text, &[set]);
+        check(&e, ErrorKind::Override, None, &[mentions]);
+        hint(&e, &[hint_mentions]);
+    }
+}
+
+/// #10: an error at a line that `--set` wrote says so.
+#[test]
+fn an_error_at_a_line_written_by_set_says_so() {
+    let e = error_with(MSD, &["simulation.t_end=\"soon\""]);
+    assert!(e.message.contains("written by --set"), "{e}");
+    let e = error(&msd_replacing("t_end = ", "t_end = \"soon\""));
+    assert!(!e.message.contains("--set"), "{e}");
+}
+
+/// #10: `clamp(0, 1, x)` (bounds first) was silently accepted.
+#[test]
+fn clamp_with_the_bounds_first_is_refused() {
+    let e = error(&msd_replacing("c = ", "c = \"clamp(0, 1, k)\""));
+    check(&e, ErrorKind::BadParameter, None, &["clamp(x, lo, hi)"]);
+}
