@@ -772,6 +772,7 @@ fn open_output(
     let sink = CsvSink::create(partial, &columns).map_err(|e| cannot(partial, e))?;
     match std::fs::remove_file(out) {
         Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            let _ = std::fs::remove_file(partial);
             Err(format!("cannot replace {}: {e}", out.display()))
         }
         _ => Ok(sink),

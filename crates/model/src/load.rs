@@ -69,8 +69,9 @@ struct CheckSpec {
     tol: Spanned<f64>,
 }
 
-/// A check of the results: at every output row, |value − expected| ≤ tol, where `value` and
-/// `expected` are expressions of `t`, parameters and output columns.
+/// A check of the results: at every output row and every accepted solver step,
+/// |value − expected| ≤ tol, where `value` and `expected` are expressions of `t`, parameters
+/// and output columns ([`Model::run_into`]).
 #[derive(Clone, Debug)]
 pub struct Check {
     /// What is checked (a column name or an expression of columns).
