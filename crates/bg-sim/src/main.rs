@@ -319,21 +319,9 @@ fn bench(a: &BenchArgs<'_>) -> ExitCode {
             }
         }
     }
-    let mut floors = Vec::new();
-    for f in a.floors {
-        match f
-            .split_once('=')
-            .map(|(p, v)| (p.trim(), v.trim().parse::<f64>()))
-        {
-            Some((p, Ok(v))) if !p.is_empty() && v.is_finite() && v >= 0.0 => {
-                floors.push((p.to_owned(), v));
-            }
-            _ => {
-                tell!("error: --floor `{f}`: expected PATTERN=VALUE with a finite VALUE ≥ 0\n  hint: --floor 'qb*=1e-3'");
-                return ExitCode::from(2);
-            }
-        }
-    }
+    let Some(floors) = parse_floors(a.floors) else {
+        return ExitCode::from(2);
+    };
     if let Some(t) = a.t_end {
         model.settings.t_end = t;
     }
