@@ -7,7 +7,7 @@
 //! and summing the others never form a false algebraic loop. Power is conserved exactly.
 
 use crate::bond::PortCausality;
-use crate::element::{CausalRule, Element, Io, Ports, Slot, Stage};
+use crate::element::{CausalRule, Element, Io, Layout, Ports, Slot, Stage};
 use crate::local_jacobian::LocalJacobian;
 
 fn dominant(io: &Io<'_>, c: PortCausality) -> usize {
@@ -36,6 +36,35 @@ fn two_stages(
     ]
 }
 
+/// Copy port `d`'s values (efforts of a 0-, flows of a 1-junction) to every other port.
+fn share(values: &mut [f64], layout: &Layout, d: usize) {
+    let (from, dim) = (layout.ports[d].offset, layout.ports[d].dim);
+    for (p, port) in layout.ports.iter().enumerate() {
+        if p != d {
+            values.copy_within(from..from + dim, port.offset);
+        }
+    }
+}
+
+/// Set port `d`'s values so that Σ_p s_p v_p = 0 (the flows of a 0-, the efforts of a
+/// 1-junction, s_p = ±1 the half-arrow's direction).
+fn balance(values: &mut [f64], layout: &Layout, d: usize) {
+    let (to, dim, sd) = (
+        layout.ports[d].offset,
+        layout.ports[d].dim,
+        layout.ports[d].sign,
+    );
+    values[to..to + dim].fill(0.0);
+    for (p, port) in layout.ports.iter().enumerate() {
+        if p != d {
+            let s = -sd * port.sign;
+            for k in 0..dim {
+                values[to + k] += s * values[port.offset + k];
+            }
+        }
+    }
+}
+
 /// 0-junction (common effort, parallel connection, Kirchhoff's current law).
 #[derive(Debug, Default)]
 pub struct ZeroJunction;
@@ -55,19 +84,11 @@ impl Element for ZeroJunction {
     }
     fn eval(&self, stage: usize, io: &mut Io<'_>) {
         let d = dominant(io, PortCausality::FlowOut);
-        for k in 0..io.dim(d) {
-            if stage == 0 {
-                let e = io.e(d, k);
-                for p in (0..io.n_ports()).filter(|&p| p != d) {
-                    io.set_e(p, k, e);
-                }
-            } else {
-                let sum: f64 = (0..io.n_ports())
-                    .filter(|&p| p != d)
-                    .map(|p| io.f_in(p, k))
-                    .sum();
-                io.set_f_in(d, k, -sum);
-            }
+        if stage == 0 {
+            share(io.effort, io.layout, d);
+        } else {
+            // f_in(d) = −Σ f_in(p): on the bond values, flow(d) = −s_d Σ s_p flow(p).
+            balance(io.flow, io.layout, d);
         }
     }
     fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
@@ -109,22 +130,12 @@ impl Element for OneJunction {
     }
     fn eval(&self, stage: usize, io: &mut Io<'_>) {
         let d = dominant(io, PortCausality::EffortOut);
-        for k in 0..io.dim(d) {
-            if stage == 0 {
-                // The bond variables share one flow whatever the half-arrows say.
-                let f = io.f_in(d, k) * io.sign(d);
-                for p in (0..io.n_ports()).filter(|&p| p != d) {
-                    let s = io.sign(p);
-                    io.set_f_in(p, k, s * f);
-                }
-            } else {
-                let sum: f64 = (0..io.n_ports())
-                    .filter(|&p| p != d)
-                    .map(|p| io.sign(p) * io.e(p, k))
-                    .sum();
-                let s = io.sign(d);
-                io.set_e(d, k, -s * sum);
-            }
+        if stage == 0 {
+            // The bond variables share one flow whatever the half-arrows say.
+            share(io.flow, io.layout, d);
+        } else {
+            // Σ s_p e_p = 0 over all ports (s: +1 into the junction).
+            balance(io.effort, io.layout, d);
         }
     }
     fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
