@@ -129,7 +129,37 @@ fn bad_input_is_an_error_not_a_panic() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("unknown solver"));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("unknown solver") && err.contains("radau5"),
+        "{err}"
+    );
+    // the same text through the file's door
+    let o = bg_sim()
+        .args(["run"])
+        .arg(model("mass_spring_damper"))
+        .args(["--set", "simulation.solver=\"euler\""])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("unknown solver") && err.contains("radau5"),
+        "{err}"
+    );
+    for rtol in ["0", "-1e-6"] {
+        let o = bg_sim()
+            .args(["run"])
+            .arg(model("mass_spring_damper"))
+            .args(["--solver", "radau5", &format!("--rtol={rtol}")])
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "rtol {rtol}");
+        assert!(
+            String::from_utf8_lossy(&o.stderr).contains("rtol"),
+            "rtol {rtol}"
+        );
+    }
     let o = bg_sim()
         .args(["run", "does/not/exist.toml"])
         .output()
