@@ -1237,6 +1237,9 @@ struct RadauStepper<'e> {
 impl RadauStepper<'_> {
     /// The earliest crossing of a limit inside the last step, if any.
     fn crossing(&self) -> Option<(f64, usize)> {
+        if self.limits.iter().all(|b| b.margin(self.radau.y()) >= 0.0) {
+            return None;
+        }
         let (t0, t1) = (self.radau.t_prev(), self.radau.t());
         let mut y = vec![0.0; self.radau.y().len()];
         let mut first: Option<(f64, usize)> = None;
