@@ -50,7 +50,7 @@ pub mod scene;
 
 pub use error::{ErrorKind, ModelError};
 pub use load::{inspect, Check, CheckResult, Inspection, Model};
-pub use scene::{Choice, Scene, Switch};
 pub use registry::{
     BuildFn, Builder, Composite, CompositeFn, ElementSpec, KindInfo, RawValue, Registry,
 };
+pub use scene::{Choice, Scene, Switch};

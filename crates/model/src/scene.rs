@@ -132,7 +132,10 @@ pub(crate) fn read(
     for (name, v) in table {
         let span = name.span();
         let fail = |m: String, hint: &str| {
-            let e = err(Some(&span), format!("[scene] `{}`: {m}", clip(name.get_ref())));
+            let e = err(
+                Some(&span),
+                format!("[scene] `{}`: {m}", clip(name.get_ref())),
+            );
             if hint.is_empty() {
                 e
             } else {
@@ -151,7 +154,12 @@ pub(crate) fn read(
         }
         let set = match t.get("set") {
             Some(toml::Value::String(s)) if !s.trim().is_empty() => s.trim().to_owned(),
-            Some(_) => return Err(fail("`set` must be a `--set` key such as \"parameters.modes1\"".into(), example)),
+            Some(_) => {
+                return Err(fail(
+                    "`set` must be a `--set` key such as \"parameters.modes1\"".into(),
+                    example,
+                ))
+            }
             None => return Err(fail("has no `set`".into(), example)),
         };
         if set.split('.').next().map(str::trim) == Some("scene") {
@@ -179,7 +187,9 @@ pub(crate) fn read(
             let label = match c {
                 toml::Value::String(s) => s.clone(),
                 // 1e5 rather than 100000.0; still a TOML float, so also its `--set` value
-                toml::Value::Float(x) if x.is_finite() && *x != 0.0 && !(1e-3..1e4).contains(&x.abs()) => {
+                toml::Value::Float(x)
+                    if x.is_finite() && *x != 0.0 && !(1e-3..1e4).contains(&x.abs()) =>
+                {
                     format!("{x:e}")
                 }
                 toml::Value::Integer(_) | toml::Value::Float(_) | toml::Value::Boolean(_) => {
@@ -187,7 +197,10 @@ pub(crate) fn read(
                 }
                 _ => {
                     return Err(fail(
-                        format!("choice `{}` must be a number, a string or a boolean", clip(&c.to_string())),
+                        format!(
+                            "choice `{}` must be a number, a string or a boolean",
+                            clip(&c.to_string())
+                        ),
                         "",
                     ))
                 }
@@ -225,12 +238,24 @@ pub(crate) fn read(
                         ));
                     };
                     let toml::Value::Array(list) = list else {
-                        return Err(fail(format!("`also.{}` must be a list of \"key=value\" strings", clip(k)), "e.g. also = { none = [\"parameters.hold_lumped=0\"] }"));
+                        return Err(fail(
+                            format!("`also.{}` must be a list of \"key=value\" strings", clip(k)),
+                            "e.g. also = { none = [\"parameters.hold_lumped=0\"] }",
+                        ));
                     };
                     for o in list {
                         match o {
                             toml::Value::String(s) if s.contains('=') => c.also.push(s.clone()),
-                            _ => return Err(fail(format!("`also.{}`: `{}` is not a \"key=value\" string", clip(k), clip(&o.to_string())), "e.g. also = { none = [\"parameters.hold_lumped=0\"] }")),
+                            _ => {
+                                return Err(fail(
+                                    format!(
+                                        "`also.{}`: `{}` is not a \"key=value\" string",
+                                        clip(k),
+                                        clip(&o.to_string())
+                                    ),
+                                    "e.g. also = { none = [\"parameters.hold_lumped=0\"] }",
+                                ))
+                            }
                         }
                     }
                 }
@@ -257,7 +282,10 @@ pub(crate) fn read(
                     let hint = e.hint.clone().unwrap_or_else(|| {
                         "`set` and `also` take the keys of `--set`: parameters.NAME, elements.NAME.OPTION, …".into()
                     });
-                    return Err(fail(format!("choice `{}`: {why}", switch.choices[k].label), &hint));
+                    return Err(fail(
+                        format!("choice `{}`: {why}", switch.choices[k].label),
+                        &hint,
+                    ));
                 }
             }
         }
