@@ -550,7 +550,20 @@ fn reduce(path: &Path, o: &bg_sim::reduce::ReduceOptions, csv: Option<&Path>) ->
             r.speedup(),
             o.repeat.max(1)
         );
-        say!("  --set {}", r.scene.overrides(&a.pick).join(" --set "));
+        // quoted for a shell where a value is a TOML string
+        let sets: Vec<String> = r
+            .scene
+            .overrides(&a.pick)
+            .into_iter()
+            .map(|o| {
+                if o.contains(['"', ' ', '\'']) {
+                    format!("'{}'", o.replace('\'', "'\\''"))
+                } else {
+                    o
+                }
+            })
+            .collect();
+        say!("  --set {}", sets.join(" --set "));
     }
     if let Some(p) = csv {
         if let Err(e) = std::fs::write(p, r.csv()) {
