@@ -1068,6 +1068,17 @@ fn check(path: &Path, set: &[String]) -> ExitCode {
             say!("  {name:<24} initial {v}");
         }
     }
+    if !report.scene.is_empty() {
+        say!(
+            "scene switches ({}, {} scenes; `bg-sim reduce` searches them), richest choice first:",
+            report.scene.switches.len(),
+            report.scene.grid_size()
+        );
+        for sw in &report.scene.switches {
+            let choices: Vec<&str> = sw.choices.iter().map(|c| c.label.as_str()).collect();
+            say!("  {:<20} {} = {}", sw.name, sw.set, choices.join(" | "));
+        }
+    }
     for n in &report.notes {
         say!("  note: {n}");
     }

@@ -151,6 +151,19 @@ fn cli_prints_the_table_and_the_answer_and_refuses_bad_input() {
     assert!(out.contains("answer: "), "{out}");
     assert_eq!(std::fs::read_to_string(&csv).unwrap().lines().count(), 7);
 
+    // `check` lists the switches
+    let o = bg_sim()
+        .arg("check")
+        .arg(model("knuckle_boom"))
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("scene switches (3, 363 scenes;"), "{out}");
+    assert!(
+        out.contains("elements.crane.lumped_model = springs | rigid | none"),
+        "{out}"
+    );
+
     for (args, said) in [
         (
             vec!["reduce", "--tol", "1e-2", "MODEL:mass_spring_damper"],

@@ -623,6 +623,8 @@ pub struct Inspection {
     pub problems: Vec<ModelError>,
     /// Notes: what loads but was likely meant otherwise ([`Model::notes`]).
     pub notes: Vec<ModelError>,
+    /// The scene switches (`[scene]`).
+    pub scene: Scene,
 }
 
 struct Parsed {
@@ -1097,7 +1099,10 @@ pub fn inspect(path: &Path, registry: &Registry, overrides: &[String]) -> Inspec
                 .collect();
             out.order = eqs.order();
             match finish(p, eqs) {
-                Ok(m) => out.notes = m.notes(),
+                Ok(m) => {
+                    out.notes = m.notes();
+                    out.scene = m.scene;
+                }
                 Err(e) => out.problems.push(e),
             }
         }
