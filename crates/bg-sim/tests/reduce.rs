@@ -209,3 +209,35 @@ fn cli_prints_the_table_and_the_answer_and_refuses_bad_input() {
         assert!(err.contains(said), "{args:?}: {err}");
     }
 }
+
+/// A scene that does not load (here p_tr < 0) is a row that failed, with the loader's
+/// reason; it never passes, and the search goes on.
+#[test]
+fn a_scene_that_does_not_load_is_reported_not_fatal() {
+    let mut o = lift_options(Search::Grid);
+    o.set = vec!["scene.p_tr.choices=[1e4, -1.0]".into()];
+    let r = reduce(&model("cylinder_lift"), &o).unwrap();
+    assert_eq!(r.tried.len(), 4);
+    let bad: Vec<_> = r
+        .tried
+        .iter()
+        .filter(|t| t.label.starts_with("p_tr=-1.0"))
+        .collect();
+    assert_eq!(bad.len(), 2);
+    for t in bad {
+        let f = t.failure.as_deref().unwrap();
+        assert!(
+            f.contains("does not load") && f.contains("p_tr") && f.contains("lift"),
+            "{f}"
+        );
+        assert!(!t.passes(1.0));
+    }
+    assert!(r.table().contains("| failed | no |"), "{}", r.table());
+    // the richest scene must run: a failing reference is an error
+    o.set = vec!["scene.p_tr.choices=[-1.0, 1e4]".into()];
+    let e = reduce(&model("cylinder_lift"), &o).unwrap_err();
+    assert!(
+        e.contains("the richest scene (p_tr=-1.0 leakage=1e11) failed"),
+        "{e}"
+    );
+}
