@@ -1,11 +1,13 @@
 //! The `bg-sim` front end as a library: the registry of every element kind this build
-//! knows, shared by the CLI and the workspace tests, and the figures of a results CSV
-//! ([`plot`]). No physics lives here.
+//! knows, shared by the CLI and the workspace tests, the figures of a results CSV
+//! ([`plot`]), the speed–accuracy measurements of `bench` ([`bench`]) and the scene search
+//! of `reduce` ([`reduce`]). No physics lives here.
 
 use bg_model::Registry;
 
 pub mod bench;
 pub mod plot;
+pub mod reduce;
 
 /// Every element kind this build knows: the core kinds plus the domain crates'.
 #[must_use]

@@ -29,6 +29,8 @@ pub enum ErrorKind {
     Causality,
     /// Simulation settings, events or outputs are wrong.
     Settings,
+    /// A `[scene]` switch is wrong.
+    Scene,
 }
 
 /// A problem in a model file.

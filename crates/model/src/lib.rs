@@ -28,6 +28,10 @@
 //! failure is a [`ModelError`] with file, line, column, element and hint.
 //! [`inspect`] goes as far as it can and reports what it found (`bg-sim check`).
 //!
+//! ## Scene switches
+//! `[scene]` declares the switches between richer and cheaper scenes (modes, lumped masses,
+//! …), each a `--set` key with its choices; [`Model::scene`] exposes them ([`scene`]).
+//!
 //! ## Element kinds
 //! [`Registry::with_core`] knows the core kinds (see [`builtin`]); domain crates register
 //! theirs with [`Registry::register`] and read parameters through [`ElementSpec`].
@@ -42,9 +46,11 @@ pub mod expr;
 pub mod load;
 pub mod overrides;
 pub mod registry;
+pub mod scene;
 
 pub use error::{ErrorKind, ModelError};
 pub use load::{inspect, Check, CheckResult, Inspection, Model};
 pub use registry::{
     BuildFn, Builder, Composite, CompositeFn, ElementSpec, KindInfo, RawValue, Registry,
 };
+pub use scene::{Choice, Scene, Switch};

@@ -18,6 +18,7 @@ use toml::Spanned;
 use crate::error::{clip, line_col, ErrorKind, ModelError};
 use crate::expr::{Expr, RESERVED};
 use crate::registry::{ElementSpec, RawValue, Registry};
+use crate::scene::Scene;
 
 type SpannedMap<V> = IndexMap<Spanned<String>, Spanned<V>>;
 
@@ -41,6 +42,8 @@ struct FileSpec {
     outputs: SpannedMap<String>,
     #[serde(default)]
     check: Vec<Spanned<CheckSpec>>,
+    #[serde(default)]
+    scene: SpannedMap<toml::Value>,
 }
 
 #[derive(Deserialize, Default)]
@@ -588,6 +591,8 @@ pub struct Model {
     pub checks: Vec<Check>,
     /// Named parameters and their values.
     pub parameters: IndexMap<String, f64>,
+    /// The scene switches the file declares (`[scene]`, [`crate::scene`]).
+    pub scene: Scene,
     /// Notes from loading: things that load but were likely meant otherwise.
     notes: Vec<ModelError>,
     source: Source,
@@ -618,12 +623,15 @@ pub struct Inspection {
     pub problems: Vec<ModelError>,
     /// Notes: what loads but was likely meant otherwise ([`Model::notes`]).
     pub notes: Vec<ModelError>,
+    /// The scene switches (`[scene]`).
+    pub scene: Scene,
 }
 
 struct Parsed {
     spec: FileSpec,
     source: Source,
     parameters: IndexMap<String, f64>,
+    scene: Scene,
 }
 
 fn syntax(file: &str, text: &str, e: &toml::de::Error) -> ModelError {
@@ -638,7 +646,7 @@ fn syntax(file: &str, text: &str, e: &toml::de::Error) -> ModelError {
     }
     ModelError::new(ErrorKind::Syntax, file, message)
         .at(pos)
-        .hint("a model has the sections title, description, [parameters], [elements], [bonds], [simulation], [initial], [[events]], [outputs], [[check]]")
+        .hint("a model has the sections title, description, [parameters], [elements], [bonds], [simulation], [initial], [[events]], [outputs], [[check]], [scene]")
 }
 
 /// The lines (1-based) of `after` that differ from those of `before`.
@@ -824,10 +832,14 @@ fn parse(
             span: ev.span(),
         });
     }
+    let scene = crate::scene::read(file, &text, &spec.scene, &|span, m| {
+        source.err(ErrorKind::Scene, span, m)
+    })?;
     Ok(Parsed {
         spec,
         source,
         parameters,
+        scene,
     })
 }
 
@@ -1087,7 +1099,10 @@ pub fn inspect(path: &Path, registry: &Registry, overrides: &[String]) -> Inspec
                 .collect();
             out.order = eqs.order();
             match finish(p, eqs) {
-                Ok(m) => out.notes = m.notes(),
+                Ok(m) => {
+                    out.notes = m.notes();
+                    out.scene = m.scene;
+                }
                 Err(e) => out.problems.push(e),
             }
         }
@@ -1101,6 +1116,7 @@ fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
         spec,
         source,
         parameters,
+        scene,
     } = p;
     // initial values
     let mut flat = Vec::new();
@@ -1252,6 +1268,7 @@ fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
         outputs,
         checks,
         parameters,
+        scene,
         notes,
         source,
     };

@@ -25,6 +25,7 @@ const SECTIONS: &[&str] = &[
     "events",
     "outputs",
     "check",
+    "scene",
 ];
 const SIMULATION_KEYS: &[&str] = &["t_start", "t_end", "dt_out", "solver", "rtol", "atol"];
 const EVENT_KEYS: &[&str] = &["t", "set"];

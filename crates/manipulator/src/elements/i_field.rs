@@ -213,9 +213,21 @@ impl ArmInertia {
         }
         let m = arm.kinematics(&q0).mass_matrix();
         if !Cholesky::new(n).factor(&m) {
+            // name the coordinates without inertia (an empty pendulum: payload mass 0)
+            let largest = (0..n).fold(0.0_f64, |a, k| a.max(m[(k, k)].abs()));
+            let names = arm.coordinate_names();
+            let without: Vec<String> = (0..n)
+                .filter(|&k| m[(k, k)].abs() <= 1e-12 * largest)
+                .filter_map(|k| names.get(k).map(ToString::to_string))
+                .collect();
+            let which = if without.is_empty() {
+                String::new()
+            } else {
+                format!(" ({} has none)", without.join(", "))
+            };
             return Err(ParamError::Shape {
                 param: "links".into(),
-                message: "the mass matrix is singular: every coordinate needs inertia (a massless link without a point mass?)".into(),
+                message: format!("the mass matrix is singular: every coordinate needs inertia{which}; a massless link needs a point mass (a pendulum with mass 0, an empty hook: give it the hook's own mass)"),
             });
         }
         let p0 = (&m * DVector::from_column_slice(&u0))
