@@ -80,3 +80,58 @@ fn rhs_and_jacobian_do_not_allocate() {
         assert!(checked.iter().any(|c| c == must), "{must} not checked");
     }
 }
+
+/// Van der Pol (μ = 1000, stiff) with its analytic Jacobian, for the Radau test below.
+struct VanDerPol;
+
+impl bondgraph::radau::OdeSystem for VanDerPol {
+    fn n(&self) -> usize {
+        2
+    }
+    fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) {
+        dy[0] = y[1];
+        dy[1] = 1000.0 * ((1.0 - y[0] * y[0]) * y[1] - y[0]);
+    }
+    fn jacobian(&mut self, _t: f64, y: &[f64], _fy: &[f64], jac: &mut DMatrix<f64>) {
+        jac[(0, 0)] = 0.0;
+        jac[(0, 1)] = 1.0;
+        jac[(1, 0)] = 1000.0 * (-2.0 * y[0] * y[1] - 1.0);
+        jac[(1, 1)] = 1000.0 * (1.0 - y[0] * y[0]);
+    }
+}
+
+/// Radau5 allocates nothing after `new`: steps (factorisations, solves), restarts and
+/// dense output, on a stiff problem that rejects steps and renews Jacobians.
+#[test]
+fn radau_steps_do_not_allocate() {
+    use bondgraph::radau::{Radau5, RadauOptions};
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let mut sys = VanDerPol;
+    let options = RadauOptions {
+        rtol: 1e-6,
+        atol: vec![1e-6],
+        ..RadauOptions::default()
+    };
+    let mut radau = Radau5::new(&mut sys, 0.0, &[2.0, 0.0], options).unwrap();
+    let mut out = [0.0; 2];
+    let region = Region::new(GLOBAL);
+    for t_stop in [0.5, 1.0, 1.5] {
+        while !radau.step(&mut sys, t_stop).unwrap().reached_stop {
+            let mid = 0.5 * (radau.t_prev() + radau.t());
+            radau.interpolate(mid, &mut out).unwrap();
+        }
+        radau.restart(None).unwrap();
+    }
+    let stats = region.change();
+    assert!(radau.stats().steps > 100, "{:?}", radau.stats());
+    assert!(radau.stats().lu_decompositions > 20, "{:?}", radau.stats());
+    assert_eq!(
+        (
+            stats.allocations + stats.reallocations,
+            stats.bytes_allocated
+        ),
+        (0, 0),
+        "(allocations, bytes) in {:?}",
+        radau.stats()
+    );
+}

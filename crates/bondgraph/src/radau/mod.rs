@@ -85,7 +85,8 @@
 //! ```
 //!
 //! # Files
-//! `tableau.rs` derives every constant from A and c; `lu.rs` is the dense LU; `stages.rs`
+//! `tableau.rs` derives every constant from A and c; `lu.rs` is the LU (dense storage,
+//! numerically found zeros skipped, complex on separate real/imaginary planes); `stages.rs`
 //! does one attempt (factorisation, Newton, error estimate, collocation polynomial);
 //! `controller.rs` chooses step sizes; `error.rs` holds [`RadauError`].
 //!
@@ -102,14 +103,13 @@ mod lu;
 mod stages;
 mod tableau;
 
-use nalgebra::Complex;
 /// The Jacobian's matrix type, re-exported so that implementing [`OdeSystem`] needs no
 /// direct dependency on nalgebra.
 pub use nalgebra::DMatrix;
 
 use controller::Controller;
 pub use error::RadauError;
-use lu::DenseLu;
+use lu::{ComplexLu, RealLu};
 use tableau::Tableau;
 
 /// What the integrator needs from the equations dy/dt = f(t, y).
@@ -238,7 +238,9 @@ pub struct Radau5 {
     w: [Vec<f64>; 3],
     fk: [Vec<f64>; 3],
     dw_real: Vec<f64>,
-    dw_complex: Vec<Complex<f64>>,
+    /// Real and imaginary parts of the complex system's right-hand side and solution.
+    dw_re: Vec<f64>,
+    dw_im: Vec<f64>,
     ytmp: Vec<f64>,
     scal: Vec<f64>,
     err_v: Vec<f64>,
@@ -248,8 +250,8 @@ pub struct Radau5 {
     /// The Jacobian was evaluated at the current (t, y).
     jac_current: bool,
     need_jac: bool,
-    lu_real: DenseLu<f64>,
-    lu_complex: DenseLu<Complex<f64>>,
+    lu_real: RealLu,
+    lu_complex: ComplexLu,
     /// The step size the LU factors belong to.
     lu_h: Option<f64>,
 
@@ -355,7 +357,8 @@ impl Radau5 {
             w: [buf(), buf(), buf()],
             fk: [buf(), buf(), buf()],
             dw_real: buf(),
-            dw_complex: vec![Complex::new(0.0, 0.0); n],
+            dw_re: buf(),
+            dw_im: buf(),
             ytmp: buf(),
             scal: buf(),
             err_v: buf(),
@@ -363,8 +366,8 @@ impl Radau5 {
             jac: DMatrix::zeros(n, n),
             jac_current: false,
             need_jac: true,
-            lu_real: DenseLu::new(n),
-            lu_complex: DenseLu::new(n),
+            lu_real: RealLu::new(n),
+            lu_complex: ComplexLu::new(n),
             lu_h: None,
             faccon: 1.0,
             theta: o.jacobian_theta,

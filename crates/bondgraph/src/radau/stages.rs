@@ -10,11 +10,10 @@ impl Radau5 {
     /// Form and factorise (γ/h)I − J and ((α + iβ)/h)I − J.
     pub(super) fn factorise(&mut self, h: f64) -> Result<(), lu::Singular> {
         let jac = self.jac.as_slice();
-        self.lu_real.set_shifted(self.tab.gamma / h, jac, |v| v);
+        self.lu_real.set_shifted(self.tab.gamma / h, jac);
         self.lu_real.factor()?;
         let shift = Complex::new(self.tab.alpha / h, self.tab.beta / h);
-        self.lu_complex
-            .set_shifted(shift, jac, |v| Complex::new(v, 0.0));
+        self.lu_complex.set_shifted(shift, jac);
         self.lu_complex.factor()
     }
 
@@ -72,20 +71,18 @@ impl Radau5 {
                 let g = |k: usize| tab.ti[k][0] * a1 + tab.ti[k][1] * a2 + tab.ti[k][2] * a3;
                 let (w1, w2, w3) = (self.w[0][i], self.w[1][i], self.w[2][i]);
                 self.dw_real[i] = g(0) - fac1 * w1;
-                self.dw_complex[i] = Complex::new(
-                    g(1) - (alphn * w2 - betan * w3),
-                    g(2) - (betan * w2 + alphn * w3),
-                );
+                self.dw_re[i] = g(1) - (alphn * w2 - betan * w3);
+                self.dw_im[i] = g(2) - (betan * w2 + alphn * w3);
             }
             self.lu_real.solve(&mut self.dw_real);
-            self.lu_complex.solve(&mut self.dw_complex);
+            self.lu_complex.solve(&mut self.dw_re, &mut self.dw_im);
             newt += 1;
             self.stats.newton_iterations += 1;
             let mut sum = 0.0;
             for i in 0..n {
                 let s = self.scal[i];
-                let (a, b) = (self.dw_real[i] / s, self.dw_complex[i] / s);
-                sum += a * a + b.re * b.re + b.im * b.im;
+                let (a, b, c) = (self.dw_real[i] / s, self.dw_re[i] / s, self.dw_im[i] / s);
+                sum += a * a + b * b + c * c;
             }
             let dyno = (sum / (3 * n).max(1) as f64).sqrt();
             if !dyno.is_finite() {
@@ -115,8 +112,8 @@ impl Radau5 {
             dyno_old = dyno.max(f64::EPSILON);
             for i in 0..n {
                 self.w[0][i] += self.dw_real[i];
-                self.w[1][i] += self.dw_complex[i].re;
-                self.w[2][i] += self.dw_complex[i].im;
+                self.w[1][i] += self.dw_re[i];
+                self.w[2][i] += self.dw_im[i];
                 let (w1, w2, w3) = (self.w[0][i], self.w[1][i], self.w[2][i]);
                 for k in 0..3 {
                     self.z[k][i] = tab.t[k][0] * w1 + tab.t[k][1] * w2 + tab.t[k][2] * w3;
