@@ -42,8 +42,10 @@ pub mod expr;
 pub mod load;
 pub mod overrides;
 pub mod registry;
+pub mod steady;
 
 pub use error::{ErrorKind, ModelError};
+pub use steady::SteadyReport;
 pub use load::{inspect, Check, CheckResult, Inspection, Model};
 pub use registry::{
     BuildFn, Builder, Composite, CompositeFn, ElementSpec, KindInfo, RawValue, Registry,

@@ -588,6 +588,8 @@ pub struct Model {
     pub checks: Vec<Check>,
     /// Named parameters and their values.
     pub parameters: IndexMap<String, f64>,
+    /// The steady state solved for the start (`[initial.steady]`), if the file asks for one.
+    pub steady: Option<crate::steady::SteadyReport>,
     /// Notes from loading: things that load but were likely meant otherwise.
     notes: Vec<ModelError>,
     source: Source,
@@ -1104,7 +1106,16 @@ fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
     } = p;
     // initial values
     let mut flat = Vec::new();
-    flatten("", &spec.initial, &mut flat);
+    let mut steady_spec = None;
+    for (k, v) in &spec.initial {
+        if k.get_ref() == "steady" && v.get_ref().is_table() {
+            steady_spec = Some(v);
+        } else {
+            let mut one = SpannedMap::default();
+            one.insert(k.clone(), v.clone());
+            flatten("", &one, &mut flat);
+        }
+    }
     for (name, value, span) in flat {
         let v = match &value {
             toml::Value::Float(f) => Some(*f),
@@ -1198,6 +1209,32 @@ fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
             )
             .hint("t_start < t_end, dt_out > 0, 0 < rtol < 1, atol > 0"));
     }
+    // a steady start ([initial.steady], crate::steady), from the values above
+    let steady = match steady_spec {
+        None => None,
+        Some(v) => {
+            let x0 = eqs.initial_state();
+            let report =
+                crate::steady::solve(v.get_ref(), &eqs, &parameters, settings.t_start, &x0)
+                    .map_err(|(message, hint)| {
+                        let e = source.err(ErrorKind::Settings, Some(&v.span()), message);
+                        match hint {
+                            Some(h) => e.hint(h),
+                            None => e,
+                        }
+                    })?;
+            if let Some(r) = &report {
+                for name in &r.kept {
+                    if let Some(i) = eqs.states().iter().position(|s| &s.name == name) {
+                        let value = r.solution.x[i];
+                        eqs.set_initial(name, value)
+                            .map_err(|e| source.err(ErrorKind::Settings, None, e.to_string()))?;
+                    }
+                }
+            }
+            report
+        }
+    };
     let (outputs, notes) = read_outputs(&spec.outputs, &source, &eqs)?;
     // checks
     let mut checks = Vec::new();
@@ -1252,6 +1289,7 @@ fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
         outputs,
         checks,
         parameters,
+        steady,
         notes,
         source,
     };
