@@ -45,8 +45,8 @@ pub mod registry;
 pub mod steady;
 
 pub use error::{ErrorKind, ModelError};
-pub use steady::SteadyReport;
 pub use load::{inspect, Check, CheckResult, Inspection, Model};
 pub use registry::{
     BuildFn, Builder, Composite, CompositeFn, ElementSpec, KindInfo, RawValue, Registry,
 };
+pub use steady::SteadyReport;

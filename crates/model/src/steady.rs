@@ -173,7 +173,11 @@ fn expand(eqs: &StateEquations, pattern: &str) -> Result<Vec<usize>, Problem> {
             }
             let (a, b) = r.split_once("..")?;
             let a = if a.is_empty() { 0 } else { a.parse().ok()? };
-            let b = if b.is_empty() { usize::MAX } else { b.parse().ok()? };
+            let b = if b.is_empty() {
+                usize::MAX
+            } else {
+                b.parse().ok()?
+            };
             Some((base, a, b))
         });
     if let Some((base, a, b)) = range {
@@ -182,7 +186,12 @@ fn expand(eqs: &StateEquations, pattern: &str) -> Result<Vec<usize>, Problem> {
             .iter()
             .enumerate()
             .filter_map(|(i, s)| {
-                let k: usize = s.name.strip_prefix(&prefix)?.strip_suffix(']')?.parse().ok()?;
+                let k: usize = s
+                    .name
+                    .strip_prefix(&prefix)?
+                    .strip_suffix(']')?
+                    .parse()
+                    .ok()?;
                 (k >= a && k < b).then_some(i)
             })
             .collect());
@@ -271,7 +280,9 @@ pub(crate) fn solve(
                                 "[initial.steady] keep: `{}` is not an unknown",
                                 eqs.states()[i].name
                             ),
-                            Some("`keep` lists unknowns whose solved values the start takes".into()),
+                            Some(
+                                "`keep` lists unknowns whose solved values the start takes".into(),
+                            ),
                         ));
                     }
                     out.push(i);
