@@ -1,10 +1,11 @@
 //! The `bg-sim` front end as a library: the registry of every element kind this build
 //! knows, shared by the CLI and the workspace tests, and the figures of a results CSV
-//! ([`plot`]). No physics lives here.
+//! ([`plot`]), the time-scale report of `bg-sim modes` ([`modes`]). No physics lives here.
 
 use bg_model::Registry;
 
 pub mod bench;
+pub mod modes;
 pub mod plot;
 
 /// Every element kind this build knows: the core kinds plus the domain crates'.

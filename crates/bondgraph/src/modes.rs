@@ -64,7 +64,10 @@ pub fn modes_of(jac: &DMatrix<f64>) -> Result<Vec<Mode>, ModesError> {
     if n == 0 {
         return Ok(Vec::new());
     }
-    let schur = nalgebra::Schur::try_new(jac.clone(), 1e-15, 10_000 * n)
+    // Balance first (B = D⁻¹JD, D diagonal powers of 2): the eigenvalues and the
+    // participation factors are those of J, computed on a matrix of much smaller norm.
+    let jac = &balanced(jac);
+    let schur = nalgebra::Schur::try_new(jac.clone(), f64::EPSILON, 10_000 * n)
         .ok_or(ModesError::NoConvergence { n })?;
     let mut lambdas: Vec<Complex<f64>> = schur
         .complex_eigenvalues()
@@ -92,6 +95,49 @@ pub fn modes_of(jac: &DMatrix<f64>) -> Result<Vec<Mode>, ModesError> {
             mode(l, p)
         })
         .collect())
+}
+
+/// Parlett–Reinsch balancing: scale row i by 1/f and column i by f (f a power of 2) until
+/// every off-diagonal row and column sum are within a factor 2 of each other.
+fn balanced(jac: &DMatrix<f64>) -> DMatrix<f64> {
+    let mut b = jac.clone();
+    let n = b.nrows();
+    for _ in 0..100 {
+        let mut done = true;
+        for i in 0..n {
+            let (mut c, mut r) = (0.0, 0.0);
+            for j in (0..n).filter(|&j| j != i) {
+                c += b[(j, i)].abs();
+                r += b[(i, j)].abs();
+            }
+            if !(c > 0.0 && r > 0.0 && c.is_finite() && r.is_finite()) {
+                continue;
+            }
+            let total = c + r;
+            let mut f = 1.0;
+            while c < r / 2.0 {
+                c *= 2.0;
+                r /= 2.0;
+                f *= 2.0;
+            }
+            while c >= r * 2.0 {
+                c /= 2.0;
+                r *= 2.0;
+                f /= 2.0;
+            }
+            if c + r < 0.95 * total {
+                done = false;
+                for j in 0..n {
+                    b[(i, j)] /= f;
+                    b[(j, i)] *= f;
+                }
+            }
+        }
+        if done {
+            break;
+        }
+    }
+    b
 }
 
 fn mode(l: Complex<f64>, participation: Vec<(usize, f64)>) -> Mode {
