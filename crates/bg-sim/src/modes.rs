@@ -143,17 +143,27 @@ impl ModesReport {
         }
         if let Some(slow) = self
             .nonzero()
-            .filter(|m| m.time_constant.is_finite())
-            .max_by(|a, b| a.time_constant.total_cmp(&b.time_constant))
+            .filter(|m| m.damped_hz > 0.0 && m.damping_ratio < 0.2)
+            .min_by(|a, b| a.damped_hz.total_cmp(&b.damped_hz))
         {
             let tau = slow.time_constant;
             out.push(format!(
-                "slowest decaying mode τ = {tau:.4} s ({:.4} Hz, ζ = {:.3}, led by {}): it settles in about 5τ = {:.3} s{}",
-                slow.natural_hz,
+                "slowest lightly damped oscillation: period {:.4} s (ζ = {:.4}, τ = {tau:.4} s, led by {}); it decays over 5τ = {:.4} s{}: any method needs steps of a fraction of its period for the whole run",
+                1.0 / slow.damped_hz,
                 slow.damping_ratio,
                 self.dominant(slow, 1).first().map_or("?", |d| d.0.as_str()),
                 5.0 * tau,
                 if 5.0 * tau > self.span { format!(", longer than the {} s run", self.span) } else { String::new() }
+            ));
+        }
+        let frozen = self
+            .nonzero()
+            .filter(|m| m.time_constant > 100.0 * self.span && m.damped_hz < 1.0 / self.span)
+            .count();
+        if frozen > 0 {
+            out.push(format!(
+                "{frozen} modes are slower than 100 runs (τ > {:.3e} s: leakage, integrators): over the run they are constants and limit no solver",
+                100.0 * self.span
             ));
         }
         let growing = self
@@ -166,8 +176,8 @@ impl ModesReport {
             ));
         }
         out.push(format!(
-            "stiffness ratio max|λ|/min|λ| = {:.3e} over the non-zero eigenvalues; {} near-zero eigenvalues (integrators, rigid-body motion) do not limit any solver",
-            self.stiffness_ratio, self.zero_modes
+            "stiffness ratio max|λ|/min|λ| = {:.3e} over the non-zero eigenvalues ({} near-zero: integrators, rigid-body motion); max|λ|·(run length) = {:.3e}: the fastest time scale fits that many times into the run, which is what makes the model stiff for it",
+            self.stiffness_ratio, self.zero_modes, lmax * self.span
         ));
         out
     }
