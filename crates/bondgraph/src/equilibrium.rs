@@ -345,7 +345,7 @@ pub fn solve_steady(
                 }
             },
         );
-        if !(smin > 1e-13 * smax) {
+        if smin.is_nan() || smin <= 1e-13 * smax {
             let null: Vec<f64> = svd
                 .v_t
                 .as_ref()
