@@ -919,8 +919,11 @@ fn modes(path: &Path, at: Option<f64>, set: &[String], json: bool, top: usize) -
         }
     };
     if let Some(t) = at {
-        if !t.is_finite() {
-            tell!("error: --at must be a finite time, got {t}");
+        if !(t.is_finite() && t >= model.settings.t_start) {
+            tell!(
+                "error: --at must be a finite time from t_start = {} s on, got {t}",
+                model.settings.t_start
+            );
             return ExitCode::from(BAD_INPUT);
         }
     }

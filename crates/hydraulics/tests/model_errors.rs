@@ -30,11 +30,7 @@ fn valve_parameters_without_a_valve_are_refused() {
 
 #[test]
 fn hold_force_and_given_pressures_exclude_each_other() {
-    let e = lift_with(
-        r#"p_p0 = "p_pre""#,
-        r#"hold_force = "m*g", p_p0 = "p_pre""#,
-    )
-    .unwrap_err();
+    let e = lift_with(r#"p_p0 = "p_pre""#, r#"hold_force = "m*g", p_p0 = "p_pre""#).unwrap_err();
     assert_eq!(e.kind, ErrorKind::BadParameter, "{e}");
     assert!(e.message.contains("hold_force"), "{e}");
 }
