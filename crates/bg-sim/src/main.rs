@@ -607,6 +607,9 @@ fn run(
             s.atol,
             s.dt_out
         );
+        if let Some(st) = &model.steady {
+            say!("{st}");
+        }
         for n in model.notes() {
             tell!("note: {n}");
         }

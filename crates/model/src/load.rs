@@ -1089,7 +1089,13 @@ pub fn inspect(path: &Path, registry: &Registry, overrides: &[String]) -> Inspec
                 .collect();
             out.order = eqs.order();
             match finish(p, eqs) {
-                Ok(m) => out.notes = m.notes(),
+                Ok(m) => {
+                    // the start as the model runs it: `[initial]` and a solved steady start
+                    for (s, v) in out.states.iter_mut().zip(&m.x0) {
+                        s.1 = *v;
+                    }
+                    out.notes = m.notes();
+                }
                 Err(e) => out.problems.push(e),
             }
         }
