@@ -100,7 +100,7 @@ fn a_start_without_equilibrium_is_refused() {
     // the spool state moves no force at t = 0: the condition does not depend on it
     let text = refused("cylinder_lift", &["initial.steady.unknowns=[\"spool.y\"]"]);
     assert!(
-        text.contains("singular") && text.contains("spool.y"),
+        text.contains("depends on none of the unknowns spool.y"),
         "{text}"
     );
     assert!(text.contains("mass.p.dot = 0"), "{text}");
@@ -121,8 +121,7 @@ fn a_start_without_equilibrium_is_refused() {
         &["initial.steady.unknowns=[\"lift_chamber_p.q\"]"],
     );
     assert!(text.contains("lift_chamber_p.p"), "{text}");
-    // a pressure the load cannot be held with: the mass pulled down by a force no finite
-    // pressure balances once the only unknown is fixed by a second, contradictory condition
+    // two conditions on the one pressure, none on the spool: singular, the spool named
     let text = refused(
         "cylinder_lift",
         &[
@@ -130,5 +129,17 @@ fn a_start_without_equilibrium_is_refused() {
             "initial.steady.unknowns=[\"lift_chamber_p.p\", \"spool.y\"]",
         ],
     );
-    assert!(text.contains("spool.y"), "{text}");
+    assert!(
+        text.contains("singular") && text.contains("spool.y"),
+        "{text}"
+    );
+    // `use` picks a named request; "none" starts from the elements' own values
+    let m = bg_tests::load("knuckle_boom", &["initial.steady.use=none"]).unwrap();
+    assert!(m.steady.is_none());
+    assert!((state(&m, "cyl1_chamber_p.p") - 1e6).abs() < 1e-9);
+    let text = refused("knuckle_boom", &["initial.steady.use=sag"]);
+    assert!(
+        text.contains("no request `sag`") && text.contains("hold, rest"),
+        "{text}"
+    );
 }

@@ -105,6 +105,16 @@ pub enum EquilibriumError {
     /// A state or condition index is out of range, or an unknown is named twice.
     #[error("invalid steady-state request: {0}")]
     Invalid(String),
+    /// A condition depends on none of the unknowns at the start.
+    #[error("the condition `{condition}` (residual {residual:.3e}) depends on none of the unknowns {} at the start: name an unknown that moves it", unknowns.join(", "))]
+    Unaffected {
+        /// The condition.
+        condition: String,
+        /// Its residual at the start.
+        residual: f64,
+        /// The unknown states.
+        unknowns: Vec<String>,
+    },
     /// The conditions do not determine the unknowns.
     #[error("singular system: the conditions do not determine the unknowns {} (scaled Jacobian rank-deficient, smallest/largest singular value {ratio:.1e}); largest residuals: {}", unknowns.join(", "), show(residuals))]
     Singular {
@@ -308,10 +318,10 @@ pub fn solve_steady(
             .map(|j| (j0[(i, j)] * p.col_scale[j]).abs())
             .fold(0.0, f64::max);
         if !(s > 0.0 && s.is_finite()) {
-            return Err(EquilibriumError::Singular {
+            return Err(EquilibriumError::Unaffected {
+                condition: condition_name(eqs, &req.conditions[i]),
+                residual: r0[i],
                 unknowns: p.names(),
-                ratio: 0.0,
-                residuals: vec![(condition_name(eqs, &req.conditions[i]), r0[i], f64::NAN)],
             });
         }
         p.row_scale[i] = s;

@@ -139,6 +139,16 @@ fn read(value: &toml::Value) -> Result<Option<Spec>, Problem> {
         .filter(|(_, v)| v.is_table())
         .map(|(k, _)| k.as_str())
         .collect();
+    if let Some(k) = t
+        .iter()
+        .find(|(k, v)| k.as_str() != "use" && !v.is_table())
+        .map(|(k, _)| k)
+    {
+        return Err((
+            format!("[initial.steady] `{k}` beside `use`: with `use`, every request is a named sub-table"),
+            Some(format!("e.g. [initial.steady.{choice}] with unknowns and conditions")),
+        ));
+    }
     if choice == "none" {
         return Ok(None);
     }
