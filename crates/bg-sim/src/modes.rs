@@ -26,6 +26,15 @@ pub struct ModesReport {
     pub zero_modes: usize,
 }
 
+/// A row sink that keeps nothing.
+struct Discard;
+
+impl bondgraph::RowSink for Discard {
+    fn row(&mut self, _row: &[f64]) -> Result<(), String> {
+        Ok(())
+    }
+}
+
 /// Linearise `model` at its initial state (`at` = None or t_start) or at time `at` of a run
 /// (the events up to `at` applied).
 pub fn analyse(model: &mut Model, at: Option<f64>) -> Result<ModesReport, String> {
@@ -33,7 +42,8 @@ pub fn analyse(model: &mut Model, at: Option<f64>) -> Result<ModesReport, String
     let (t, x) = match at {
         Some(t_at) if t_at > model.settings.t_start => {
             model.settings.t_end = t_at;
-            let out = model.run().map_err(|e| e.to_string())?;
+            // only the final state is wanted: the rows are dropped as they come
+            let (out, _) = model.run_into(&mut Discard).map_err(|e| e.to_string())?;
             if let Some(e) = &out.error {
                 return Err(format!("the run to t = {t_at} s stopped early: {e}"));
             }
