@@ -45,8 +45,8 @@
 //! ## Steady states and modes
 //! [`solve_steady`] solves chosen unknown states for as many conditions (state derivatives or
 //! states held at values) by Newton's method with the exact Jacobian ([`equilibrium`]).
-//! [`modes`] linearises at a state and lists every eigenvalue as frequency, damping ratio and
-//! time constant with the participation of each state ([`modes`](mod@modes)).
+//! [`modes`](fn@modes) linearises at a state and lists every eigenvalue as frequency, damping ratio and
+//! time constant with the participation of each state ([`modes`](mod@modes) module).
 //!
 //! ## Simulation
 //! [`simulate`] integrates with diffsol ([`Method`]: BDF, ESDIRK34, TR-BDF2, Tsit45), with
