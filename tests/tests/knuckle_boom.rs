@@ -5,8 +5,7 @@
 //!   model's own equations) are the rigid static balance (`τ_b F + G = 0`, first two rows)
 //!   computed three more ways: by the hand-derived formulas the file used to carry, by the
 //!   hand-written Lagrange model below and by the manipulator crate's own `τ_b` and `G`;
-//! * the file's full-rest start (`initial.steady.use = "rest"`) is a rest state of the
-//!   flexible crane: every acceleration at t = 0 below 1e-9;
+//!   (the full-rest start, `initial.steady.use = "rest"`, is tested in `steady.rs`);
 //! * with 0 modes and rigidly attached lumped masses, t = 0 is a rest state; with flexible
 //!   links released undeformed it is not;
 //! * a 0-mode run matches [`RigidCrane`]: Lagrange's equations of two rigid booms, the
