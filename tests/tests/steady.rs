@@ -37,6 +37,33 @@ fn cylinder_lift_starts_holding_its_load() {
     assert!(a.abs() < 1e-9, "acceleration at t = 0: {a:e}");
 }
 
+/// A condition on any variable, not only a state: the cylinder force F_c = m·g (an effort,
+/// differenced over the unknowns) gives the same pressure as zero acceleration, to 1e-9.
+#[test]
+fn a_condition_on_an_effort() {
+    let m = bg_tests::load(
+        "cylinder_lift",
+        &["initial.steady.conditions=[\"lift_piston.mech.e = m*g\"]"],
+    )
+    .unwrap();
+    let report = m.steady.as_ref().unwrap();
+    eprintln!("{report}");
+    assert!(
+        report.to_string().contains("lift_piston.mech.e = "),
+        "{report}"
+    );
+    let p = &m.parameters;
+    let want = (p["m"] * p["g"] + p["a_r"] * p["p_pre"]) / p["a_p"];
+    let got = state(&m, "lift_chamber_p.p");
+    assert!((got / want - 1.0).abs() < 1e-9, "{got} vs {want}");
+    // a name that is neither a state nor a variable is refused with a hint
+    let text = refused(
+        "cylinder_lift",
+        &["initial.steady.conditions=[\"lift_piston.force = 0\"]"],
+    );
+    assert!(text.contains("no state `lift_piston.force`"), "{text}");
+}
+
 /// The crane's full-rest start (`--set initial.steady.use=rest`): pressures, beam sag and
 /// spring preloads solved together, so every acceleration at t = 0 (the nine of the arm and
 /// the six of the lumped masses) is below 1e-9 in SI units.

@@ -1,12 +1,13 @@
 //! Steady states as a solve: Newton's method on chosen unknown states and conditions.
 //!
 //! Some states are unknown (e.g. the chamber pressures that hold a load, a beam's modal
-//! coordinates under gravity); as many conditions fix them, each either a state derivative
-//! (`mass.p.dot = 0`: an acceleration, or any rate, held at a value) or a state itself. The
-//! other states keep their values. The conditions are solved by Newton's method with the
-//! exact Jacobian of [`StateEquations::jacobian`] (its rows for the derivative conditions,
-//! unit rows for the state conditions) and a backtracking (Armijo) line search on the sum of
-//! squared scaled residuals.
+//! coordinates under gravity); as many conditions fix them, each a state derivative
+//! (`mass.p.dot = 0`: an acceleration, or any rate, held at a value), a state itself, or any
+//! other variable of the equations (an effort, flow or signal). The other states keep their
+//! values. The conditions are solved by Newton's method with the exact Jacobian of
+//! [`StateEquations::jacobian`] (its rows for the derivative conditions, unit rows for the
+//! state conditions; central differences over the unknowns for other variables) and a
+//! backtracking (Armijo) line search on the sum of squared scaled residuals.
 //!
 //! **Scaling.** An unknown is measured in units of its scale c_j = max(|x_j|, nominal_j) at
 //! the start; a condition in units of its row scale s_i = max_j |∂r_i/∂x_j|·c_j there (what a
@@ -21,10 +22,10 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::equations::StateEquations;
+use crate::equations::{Probe, StateEquations};
 
 /// One condition of a steady state.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Condition {
     /// dx_i/dt = value (e.g. 0: the state is at rest).
     Derivative {
@@ -37,6 +38,16 @@ pub enum Condition {
     State {
         /// State index.
         state: usize,
+        /// Required value.
+        value: f64,
+    },
+    /// Any variable the equations compute (an effort, a flow, a signal: a [`Probe`]) held at
+    /// a value; its row of the Jacobian is a central difference over the unknowns.
+    Variable {
+        /// What to read.
+        probe: Probe,
+        /// Its name in reports (`lift_piston.mech.e`).
+        label: String,
         /// Required value.
         value: f64,
     },
@@ -148,9 +159,10 @@ fn show(r: &[(String, f64, f64)]) -> String {
 #[must_use]
 pub fn condition_name(eqs: &StateEquations, c: &Condition) -> String {
     let name = |i: usize| eqs.states().get(i).map_or("?", |s| s.name.as_str());
-    match *c {
-        Condition::Derivative { state, value } => format!("{}.dot = {value}", name(state)),
-        Condition::State { state, value } => format!("{} = {value}", name(state)),
+    match c {
+        Condition::Derivative { state, value } => format!("{}.dot = {value}", name(*state)),
+        Condition::State { state, value } => format!("{} = {value}", name(*state)),
+        Condition::Variable { label, value, .. } => format!("{label} = {value}"),
     }
 }
 
@@ -167,13 +179,24 @@ struct Problem<'a> {
 impl Problem<'_> {
     /// Residuals at x (unscaled).
     fn residuals(&mut self, x: &[f64]) -> Vec<f64> {
+        let variables = self
+            .req
+            .conditions
+            .iter()
+            .any(|c| matches!(c, Condition::Variable { .. }));
+        if variables {
+            self.eqs.evaluate(self.t, x);
+        }
         self.eqs.rhs(self.t, x, &mut self.dx);
         self.req
             .conditions
             .iter()
-            .map(|c| match *c {
-                Condition::Derivative { state, value } => self.dx[state] - value,
-                Condition::State { state, value } => x[state] - value,
+            .map(|c| match c {
+                Condition::Derivative { state, value } => self.dx[*state] - value,
+                Condition::State { state, value } => x[*state] - value,
+                Condition::Variable { probe, value, .. } => {
+                    self.eqs.read(*probe, self.t, x) - value
+                }
             })
             .collect()
     }
@@ -182,19 +205,51 @@ impl Problem<'_> {
     fn jacobian(&mut self, x: &[f64]) -> DMatrix<f64> {
         self.eqs.jacobian(self.t, x, &mut self.jac);
         let (m, n) = (self.req.conditions.len(), self.req.unknowns.len());
-        DMatrix::from_fn(m, n, |i, j| {
+        let mut out = DMatrix::from_fn(m, n, |i, j| {
             let u = self.req.unknowns[j];
-            match self.req.conditions[i] {
-                Condition::Derivative { state, .. } => self.jac[(state, u)],
+            match &self.req.conditions[i] {
+                Condition::Derivative { state, .. } => self.jac[(*state, u)],
                 Condition::State { state, .. } => {
-                    if state == u {
+                    if *state == u {
                         1.0
                     } else {
                         0.0
                     }
                 }
+                Condition::Variable { .. } => 0.0,
             }
-        })
+        });
+        // rows of variables: central differences, step 1e-7 of each unknown's scale
+        let rows: Vec<(usize, Probe)> = self
+            .req
+            .conditions
+            .iter()
+            .enumerate()
+            .filter_map(|(i, c)| match c {
+                Condition::Variable { probe, .. } => Some((i, *probe)),
+                _ => None,
+            })
+            .collect();
+        if !rows.is_empty() {
+            let mut xp = x.to_vec();
+            for j in 0..n {
+                let u = self.req.unknowns[j];
+                let h = 1e-7 * self.col_scale[j];
+                xp[u] = x[u] + h;
+                self.eqs.evaluate(self.t, &xp);
+                let plus: Vec<f64> = rows
+                    .iter()
+                    .map(|&(_, p)| self.eqs.read(p, self.t, &xp))
+                    .collect();
+                xp[u] = x[u] - h;
+                self.eqs.evaluate(self.t, &xp);
+                for (k, &(i, p)) in rows.iter().enumerate() {
+                    out[(i, j)] = (plus[k] - self.eqs.read(p, self.t, &xp)) / (2.0 * h);
+                }
+                xp[u] = x[u];
+            }
+        }
+        out
     }
 
     fn scaled(&self, r: &[f64]) -> Vec<f64> {
@@ -266,9 +321,10 @@ pub fn solve_steady(
         }
     }
     for c in &req.conditions {
-        let (Condition::Derivative { state, .. } | Condition::State { state, .. }) = *c;
-        if state >= n {
-            return Err(EquilibriumError::Invalid(format!("no state {state}")));
+        if let Condition::Derivative { state, .. } | Condition::State { state, .. } = c {
+            if *state >= n {
+                return Err(EquilibriumError::Invalid(format!("no state {state}")));
+            }
         }
     }
     if req.unknowns.len() != req.conditions.len() {

@@ -4,7 +4,7 @@
 //! ```toml
 //! [initial.steady]
 //! unknowns   = ["lift_chamber_p.p"]              # states to solve for; `x.q[*]`, `x.q[3..]` allowed
-//! conditions = ["mass.p.dot = 0"]                # `STATE.dot = value` or `STATE = value`
+//! conditions = ["mass.p.dot = 0"]                # `STATE.dot = value`, `STATE = value`, `VARIABLE = value`
 //! keep       = ["lift_chamber_p.p"]              # optional: unknowns the start takes (default all)
 //! tol        = 1e-10                             # optional: largest scaled residual
 //! ```
@@ -114,8 +114,12 @@ fn read_one(name: &str, t: &toml::Table) -> Result<Spec, Problem> {
     Ok(Spec {
         name: name.to_owned(),
         unknowns: strings(t, "unknowns", "state names")?.unwrap_or_default(),
-        conditions: strings(t, "conditions", "`STATE.dot = value` or `STATE = value`")?
-            .unwrap_or_default(),
+        conditions: strings(
+            t,
+            "conditions",
+            "`STATE.dot = value`, `STATE = value` or `VARIABLE = value`",
+        )?
+        .unwrap_or_default(),
         keep: strings(t, "keep", "state names")?,
         tol,
     })
@@ -246,6 +250,17 @@ fn conditions(
         Some(p) => (p, true),
         None => (lhs, false),
     };
+    // not a state: any other variable the equations compute (effort, flow, signal)
+    let is_state = expand(eqs, pattern).is_ok();
+    if !is_state {
+        if let Some(probe) = eqs.probe(lhs) {
+            return Ok(vec![Condition::Variable {
+                probe,
+                label: lhs.to_owned(),
+                value,
+            }]);
+        }
+    }
     Ok(expand(eqs, pattern)?
         .into_iter()
         .map(|state| {
