@@ -1,9 +1,11 @@
 //! The knuckle boom crane, `models/knuckle_boom.toml`, against the design page
 //! (`shared/design/knuckle-boom.md`) and against an independent rigid-body computation:
 //!
-//! * the hold forces of the file's parameter expressions are the rigid static balance
-//!   (`τ_b F + G = 0`, first two rows), computed here twice more: by the hand-written
-//!   Lagrange model below and by the manipulator crate's own `τ_b` and `G`;
+//! * the initial pressures the file's steady start solves (`[initial.steady]`, Newton on the
+//!   model's own equations) are the rigid static balance (`τ_b F + G = 0`, first two rows)
+//!   computed three more ways: by the hand-derived formulas the file used to carry, by the
+//!   hand-written Lagrange model below and by the manipulator crate's own `τ_b` and `G`;
+//!   (the full-rest start, `initial.steady.use = "rest"`, is tested in `steady.rs`);
 //! * with 0 modes and rigidly attached lumped masses, t = 0 is a rest state; with flexible
 //!   links released undeformed it is not;
 //! * a 0-mode run matches [`RigidCrane`]: Lagrange's equations of two rigid booms, the
@@ -58,12 +60,9 @@ fn scene(doc: &mut DocumentMut, modes: u32, lumped: &str) {
     doc["parameters"]["modes1"] = value(i64::from(modes));
     doc["parameters"]["modes2"] = value(i64::from(modes));
     doc["elements"]["crane"]["lumped_model"] = value(lumped);
-    if lumped == "none" {
-        doc["parameters"]["hold_lumped"] = value(0);
-    }
 }
 
-/// Each scene switch is one `--set` (two for the masses left out), with every design-page
+/// Each scene switch is one `--set`, with every design-page
 /// column still written: the qb columns of modes that are not modelled read 0.
 #[test]
 fn scene_switches_are_single_sets() {
@@ -71,10 +70,7 @@ fn scene_switches_are_single_sets() {
         &["parameters.modes1=0", "parameters.modes2=0"][..],
         &["parameters.modes1=1", "parameters.modes2=5"][..],
         &["elements.crane.lumped_model=rigid"][..],
-        &[
-            "elements.crane.lumped_model=none",
-            "parameters.hold_lumped=0",
-        ][..],
+        &["elements.crane.lumped_model=none"][..],
     ] {
         let mut m = bg_tests::load("knuckle_boom", set).unwrap_or_else(|e| panic!("{set:?}: {e}"));
         m.settings.t_end = 0.02;
@@ -456,20 +452,84 @@ fn rigid_model(rtol: f64) -> Model {
 // ---------------------------------------------------------------------------------------
 // The tests
 
-/// The file's hold forces (parameter expressions) are the design page's rigid static
-/// balance: the same numbers from the hand-written model and from the manipulator crate's
-/// τ_b and G, and about +207 kN and −80.6 kN.
+/// The hold forces the design page derives by hand (the formulas `models/knuckle_boom.toml`
+/// carried before its steady start): g·Σ / (∂l/∂q), Σ the first moments of the masses
+/// outboard of each joint.
+fn hand_derived_hold_forces(p: &IndexMap<String, f64>) -> (f64, f64) {
+    let (phi1, phi2) = (p["q1_0"], p["q1_0"] + p["q2_0"]);
+    let phi3 = phi2 + p["q3_0"];
+    let (m_1, m_2) = (p["rho"] * p["A"] * p["L1"], p["rho"] * p["A"] * p["L2"]);
+    let x_j2 = p["L1"] * phi1.cos();
+    let x_j3 = x_j2 + p["L2"] * phi2.cos();
+    let x_m3 = x_j3 + p["L3"] * phi3.cos();
+    let s2 = m_2 * p["L2"] / 2.0 * phi2.cos()
+        + p["m3"] * (x_m3 - x_j2)
+        + p["m_p"] * p["h3"] * phi2.cos();
+    let s1 = m_1 * p["L1"] / 2.0 * phi1.cos()
+        + m_2 * (x_j2 + p["L2"] / 2.0 * phi2.cos())
+        + p["m3"] * x_m3
+        + p["m_p"] * p["h1"] * phi1.cos()
+        + p["m_b"] * (p["L1"] - p["h2"]) * phi1.cos()
+        + p["m_p"] * (x_j2 + p["h3"] * phi2.cos());
+    let (h1, h2, h3, d0) = (p["h1"], p["h2"], p["h3"], p["d0"]);
+    let l1 = (h1 * h1 + d0 * d0 - 2.0 * h1 * d0 * (p["q1_0"] + p["beta3"]).cos()).sqrt();
+    let l2 = (h2 * h2 + h3 * h3 + 2.0 * h2 * h3 * p["q2_0"].cos()).sqrt();
+    (
+        p["g"] * s1 / (h1 * d0 * (p["q1_0"] + p["beta3"]).sin() / l1),
+        p["g"] * s2 / (-h2 * h3 * p["q2_0"].sin() / l2),
+    )
+}
+
+fn state(model: &Model, name: &str) -> f64 {
+    let i = model
+        .equations
+        .states()
+        .iter()
+        .position(|s| s.name == name)
+        .unwrap_or_else(|| panic!("no state {name}"));
+    model.x0[i]
+}
+
+/// The file's steady start solves the initial pressures on the model's own equations; they
+/// equal the design page's hand-derived hold pressures to 1e-6 relative (measured: 5e-13),
+/// and the forces they give are the rigid static balance computed by the hand-written model
+/// and by the manipulator crate's own τ_b and G: about +207 kN and −80.6 kN.
 #[test]
 fn hold_forces_are_the_rigid_static_balance() {
     let model = variant(|_| {});
     let p = model.parameters.clone();
-    let (f1, f2) = (p["F1_hold"], p["F2_hold"]);
-    eprintln!("file: F1 = {f1:.6} N, F2 = {f2:.6} N");
+    let report = model
+        .steady
+        .as_ref()
+        .expect("the file asks for a steady start");
+    eprintln!("{report}");
+    let (a_p, a_r, pre) = (p["A_p"], p["A_r"], p["p_pre"]);
+    let (pp1, pr1) = (
+        state(&model, "cyl1_chamber_p.p"),
+        state(&model, "cyl1_chamber_r.p"),
+    );
+    let (pp2, pr2) = (
+        state(&model, "cyl2_chamber_p.p"),
+        state(&model, "cyl2_chamber_r.p"),
+    );
+    assert!(
+        (pr1 - pre).abs() < 1e-9 && (pp2 - pre).abs() < 1e-9,
+        "the less loaded chambers stay at p_pre"
+    );
+    let (h1, h2) = hand_derived_hold_forces(&p);
+    // the design page's rule: the less loaded chamber at p_pre
+    let (want_p1, want_r2) = ((h1 + a_r * pre) / a_p, (a_p * pre - h2) / a_r);
+    let (e1, e2) = ((pp1 / want_p1 - 1.0).abs(), (pr2 / want_r2 - 1.0).abs());
+    eprintln!("solved P_p1 = {pp1:.6} Pa (hand-derived {want_p1:.6}, rel. {e1:.1e}), P_r2 = {pr2:.6} Pa ({want_r2:.6}, rel. {e2:.1e})");
+    assert!(e1 < 1e-6 && e2 < 1e-6, "{e1:e} {e2:e}");
+    let (f1, f2) = (a_p * pp1 - a_r * pr1, a_p * pp2 - a_r * pr2);
+    eprintln!("solved: F1 = {f1:.6} N, F2 = {f2:.6} N");
 
     let crane = RigidCrane::new(p.clone());
     let mine = crane.hold_forces([p["q1_0"], p["q2_0"], p["q3_0"]]);
     assert!((mine[0] - f1).abs() <= 1e-9 * f1.abs(), "{mine:?} vs {f1}");
     assert!((mine[1] - f2).abs() <= 1e-9 * f2.abs(), "{mine:?} vs {f2}");
+    assert!((h1 - f1).abs() <= 1e-9 * f1.abs() && (h2 - f2).abs() <= 1e-9 * f2.abs());
 
     // the manipulator crate: first two rows of τ_b F + G = 0
     let beam = |l: f64| {
@@ -785,7 +845,8 @@ fn file_settings_agree_with_rtol_1e9_on_every_column() {
 }
 
 /// The scene switches: modes per link 0–10, lumped masses on springs, rigid or left out
-/// (with `hold_lumped = 0`, so that the rigid crane still starts at rest).
+/// (the steady start follows: its `[*]` patterns name no lumped-mass state when there is
+/// none, so the rigid crane still starts at rest).
 #[test]
 fn scene_switches_load_and_run() {
     for (modes, lumped) in [(0, "none"), (1, "springs"), (2, "rigid"), (10, "springs")] {

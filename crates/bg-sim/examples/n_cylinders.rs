@@ -38,7 +38,7 @@ atol = 1e-8
             s,
             r#"ctrl{i} = {{ kind = "p_control", input = "lift{i}_piston.l", setpoint = {l_d}, gain = 5.0, min = -1.0, max = 1.0 }}
 spool{i} = {{ kind = "lag", input = "ctrl{i}.out", tau = 0.05 }}
-lift{i} = {{ kind = "hydraulics.cylinder", a_p = "a_p", a_r = "a_r", l0 = 1.2, l_p0 = 0.05, l_r0 = 1.05, s_max = 1.0, s0 = 0.2, beta = 1.5e9, p_t = 0.0, hold_force = "m*g", x_v = "spool{i}.out", p_s = "p_s", p_tr = 1e5, alpha = "alpha", r_int = 1e11 }}
+lift{i} = {{ kind = "hydraulics.cylinder", a_p = "a_p", a_r = "a_r", l0 = 1.2, l_p0 = 0.05, l_r0 = 1.05, s_max = 1.0, s0 = 0.2, beta = 1.5e9, p_t = 0.0, p_p0 = 1e6, p_r0 = 1e6, x_v = "spool{i}.out", p_s = "p_s", p_tr = 1e5, alpha = "alpha", r_int = 1e11 }}
 load{i} = {{ kind = "1" }}
 mass{i} = {{ kind = "I", m = "m" }}
 gravity{i} = {{ kind = "Se", e = "-m*g" }}
@@ -52,6 +52,19 @@ friction{i} = {{ kind = "R", r = 2e5 }}"#
             "b{i}_1 = \"lift{i}.mech -> load{i}\"\nb{i}_2 = \"gravity{i} -> load{i}\"\nb{i}_3 = \"load{i} -> mass{i}\"\nb{i}_4 = \"load{i} -> friction{i}\""
         );
     }
+    // start at rest: each piston-side pressure holds its mass (docs/model-format.md)
+    let list = |f: &dyn Fn(usize) -> String| {
+        (1..=n)
+            .map(|i| format!("\"{}\"", f(i)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let _ = writeln!(
+        s,
+        "\n[initial.steady]\nunknowns = [{}]\nconditions = [{}]",
+        list(&|i| format!("lift{i}_chamber_p.p")),
+        list(&|i| format!("mass{i}.p.dot = 0"))
+    );
     s.push_str("\n[outputs]\n");
     for i in 1..=n {
         let _ = writeln!(

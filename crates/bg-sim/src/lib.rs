@@ -1,11 +1,13 @@
 //! The `bg-sim` front end as a library: the registry of every element kind this build
 //! knows, shared by the CLI and the workspace tests, the figures of a results CSV
-//! ([`plot`]), the speed–accuracy measurements of `bench` ([`bench`]) and the scene search
-//! of `reduce` ([`reduce`]). No physics lives here.
+//! ([`plot`]), the speed–accuracy measurements of `bench` ([`bench`]), the scene search
+//! of `reduce` ([`reduce`]) and the time-scale report of `bg-sim modes` ([`modes`]). No
+//! physics lives here.
 
 use bg_model::Registry;
 
 pub mod bench;
+pub mod modes;
 pub mod plot;
 pub mod reduce;
 

@@ -99,6 +99,25 @@ enum Command {
     },
     /// List the element kinds a model file can use.
     Kinds,
+    /// The model's time scales: linearise at the initial state (or at time T of a run) and
+    /// list every eigenvalue as frequency, damping ratio and time constant with the states
+    /// that take part in it, the stiffness ratio and what it means for the solver.
+    Modes {
+        /// The model file.
+        model: PathBuf,
+        /// Linearise at this time of a run (s) instead of the initial state.
+        #[arg(long, value_name = "T")]
+        at: Option<f64>,
+        /// Override a value of the model file (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Write JSON (for scripts) instead of the table.
+        #[arg(long)]
+        json: bool,
+        /// Dominant states named per mode (those with a participation of at least 5 %).
+        #[arg(long, default_value_t = 3)]
+        top: usize,
+    },
     /// Measure the speed–accuracy trade: every solver at every rtol against a reference
     /// (wall time, steps, rhs evaluations, the worst scaled error of the scored columns).
     Bench {
@@ -218,7 +237,7 @@ fn main() -> ExitCode {
     // For these commands the report on stdout is the product: losing it is a failure.
     let stdout_is_product = matches!(
         cli.command,
-        Command::Kinds | Command::Check { .. } | Command::Compare { .. }
+        Command::Kinds | Command::Check { .. } | Command::Compare { .. } | Command::Modes { .. }
     );
     let code = dispatch(cli.command);
     let lost = STDOUT_ERROR.lock().ok().and_then(|e| *e);
@@ -270,6 +289,13 @@ fn dispatch(command: Command) -> ExitCode {
             }
         }
         Command::Check { model, set } => check(&model, &set),
+        Command::Modes {
+            model,
+            at,
+            set,
+            json,
+            top,
+        } => modes(&model, at, &set, json, top),
         Command::Kinds => {
             for (k, info) in registry().kinds() {
                 say!("{k:<24} {}", info.summary);
@@ -730,6 +756,9 @@ fn run(
             s.atol,
             s.dt_out
         );
+        if let Some(st) = &model.steady {
+            say!("{st}");
+        }
         for n in model.notes() {
             tell!("note: {n}");
         }
@@ -1030,6 +1059,42 @@ impl RowSink for CsvSink {
             self.flush().map_err(|e| e.to_string())?;
         }
         Ok(())
+    }
+}
+
+fn modes(path: &Path, at: Option<f64>, set: &[String], json: bool, top: usize) -> ExitCode {
+    let mut model = match Model::load(path, &registry(), set) {
+        Ok(m) => m,
+        Err(e) => {
+            tell!("error: {e}");
+            return ExitCode::from(BAD_INPUT);
+        }
+    };
+    if let Some(t) = at {
+        if !(t.is_finite() && t >= model.settings.t_start) {
+            tell!(
+                "error: --at must be a finite time from t_start = {} s on, got {t}",
+                model.settings.t_start
+            );
+            return ExitCode::from(BAD_INPUT);
+        }
+    }
+    match bg_sim::modes::analyse(&mut model, at) {
+        Ok(r) => {
+            if json {
+                say!("{}", r.json(top));
+            } else {
+                if let Some(s) = &model.steady {
+                    say!("{s}");
+                }
+                say!("{}", r.text(top));
+            }
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            tell!("error: {e}");
+            ExitCode::from(FAILED)
+        }
     }
 }
 

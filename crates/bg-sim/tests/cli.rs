@@ -708,3 +708,72 @@ fn three_million_rows_stream_in_bounded_memory() {
             .count();
     assert_eq!(lines, 3_000_002);
 }
+
+/// The number after `"key": ` in `json` (the first occurrence).
+fn json_number(json: &str, key: &str) -> f64 {
+    let at = json.find(&format!("\"{key}\": ")).unwrap() + key.len() + 4;
+    let end = json[at..].find([',', '}']).unwrap() + at;
+    json[at..end].trim().parse().unwrap()
+}
+
+/// `bg-sim modes` on the series RLC circuit: ω_n = 1/√(LC) = 316.23 rad/s and
+/// ζ = (R/2)·√(C/L) = 0.1581 (R = 10 Ω, L = 0.1 H, C = 1e-4 F), to 1e-6 relative, in the JSON
+/// for scripts and in the table; `--at` runs to T first; a bad `--at` is refused.
+#[test]
+fn modes_lists_eigenvalues_against_closed_forms() {
+    let o = bg_sim()
+        .args(["modes", "--json"])
+        .arg(model("rlc_series"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let json = String::from_utf8(o.stdout).unwrap();
+    let (r, l, c) = (10.0f64, 0.1f64, 1e-4f64);
+    let fn_hz = 1.0 / (l * c).sqrt() / (2.0 * std::f64::consts::PI);
+    let zeta = r / 2.0 * (c / l).sqrt();
+    let got_f = json_number(&json, "natural_hz");
+    let got_z = json_number(&json, "damping_ratio");
+    eprintln!("f_n {got_f} vs {fn_hz}, ζ {got_z} vs {zeta}");
+    assert!((got_f / fn_hz - 1.0).abs() < 1e-6, "{json}");
+    assert!((got_z / zeta - 1.0).abs() < 1e-6, "{json}");
+    assert!(json.contains("\"state\": \"inductor.p\""), "{json}");
+
+    let o = bg_sim()
+        .args(["modes", "--at", "0.05"])
+        .arg(model("rlc_series"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8(o.stdout).unwrap();
+    assert!(text.contains("linearised at t = 0.05 s"), "{text}");
+    assert!(text.contains("50.329212"), "{text}");
+    assert!(text.contains("stiffness ratio"), "{text}");
+
+    let o = bg_sim()
+        .args(["modes", "--at=-1"])
+        .arg(model("rlc_series"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("from t_start = 0 s on"));
+}
+
+/// The crane at t = 0 (default start): 38 states, the fastest mode a bending mode of the
+/// knuckle boom, the payload swing's period near 5 s, and no growing mode.
+#[test]
+fn modes_of_the_crane() {
+    let o = bg_sim()
+        .arg("modes")
+        .arg(model("knuckle_boom"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8(o.stdout).unwrap();
+    assert!(text.contains("38 states"), "{text}");
+    assert!(text.contains("steady start `hold`"), "{text}");
+    assert!(
+        text.contains("slowest lightly damped oscillation: period 4.9"),
+        "{text}"
+    );
+    assert!(!text.contains("grow"), "{text}");
+}

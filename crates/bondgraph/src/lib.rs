@@ -42,6 +42,12 @@
 //! [`StateEquations::new`] orders every element's stages into an evaluation plan computing
 //! dx/dt = f(t, x) and every effort, flow and signal, and refuses algebraic loops.
 //!
+//! ## Steady states and modes
+//! [`solve_steady`] solves chosen unknown states for as many conditions (state derivatives or
+//! states held at values) by Newton's method with the exact Jacobian ([`equilibrium`]).
+//! [`modes`](fn@modes) linearises at a state and lists every eigenvalue as frequency, damping ratio and
+//! time constant with the participation of each state ([`modes`](mod@modes) module).
+//!
 //! ## Simulation
 //! [`simulate`] integrates with diffsol ([`Method`]: BDF, ESDIRK34, TR-BDF2, Tsit45), with
 //! output times, scheduled [`Event`]s and [`Statistics`], and keeps the rows computed when it
@@ -53,9 +59,11 @@ pub mod causality;
 pub mod element;
 pub mod elements;
 pub mod equations;
+pub mod equilibrium;
 pub mod error;
 pub mod graph;
 pub mod local_jacobian;
+pub mod modes;
 pub mod radau;
 pub mod simulate;
 
@@ -67,9 +75,11 @@ pub use element::{
 };
 pub use elements::*;
 pub use equations::{Probe, StateEquations, StateInfo};
+pub use equilibrium::{solve_steady, Condition, Equilibrium, EquilibriumError, SteadyRequest};
 pub use error::{CausalityError, Error, GraphError, ParamError, SimulationError};
 pub use graph::{BondGraph, Node};
 pub use local_jacobian::{check_partials, LocalJacobian, LocalShape};
+pub use modes::{modes, modes_of, stiffness_ratio, Mode, ModesError};
 /// The dense matrix type of [`StateEquations::jacobian`].
 pub use nalgebra::DMatrix;
 pub use radau::{OdeSystem, Radau5, RadauError, RadauOptions, RadauStats, StepReport};

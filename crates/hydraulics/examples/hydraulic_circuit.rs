@@ -17,8 +17,9 @@
 
 use bg_hydraulics::{reg_root, Chamber, Cylinder, EndStopSpec, InitialPressures, Orifice};
 use bondgraph::{
-    assign_causality, simulate, BondGraph, Capacitor, EffortSource, FlowSource, Inertia,
-    OneJunction, Output, Resistor, Settings, StateEquations, ZeroJunction,
+    assign_causality, simulate, solve_steady, BondGraph, Capacitor, Condition, EffortSource,
+    FlowSource, Inertia, OneJunction, Output, Resistor, Settings, StateEquations, SteadyRequest,
+    ZeroJunction,
 };
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -99,6 +100,37 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ..Settings::default()
     };
     let x0 = eqs.initial_state();
+    // The same rest state as a solve (bondgraph::solve_steady): the line, chamber and spring
+    // states such that no pressure changes and nothing moves, from the empty start.
+    let index = |name: &str| {
+        eqs.states()
+            .iter()
+            .position(|s| s.name == name)
+            .ok_or_else(|| format!("no state `{name}`"))
+    };
+    let unknowns = [
+        "hose.p",
+        "cyl_chamber_p.p",
+        "cyl_chamber_r.p",
+        "spring.q",
+        "mass.p",
+    ]
+    .iter()
+    .map(|n| index(n))
+    .collect::<Result<Vec<_>, _>>()?;
+    let conditions = unknowns
+        .iter()
+        .map(|&state| Condition::Derivative { state, value: 0.0 })
+        .collect();
+    let mut guess = x0.clone();
+    guess[unknowns[0]] = 1e6; // a pressure scale to start from
+    let rest = solve_steady(
+        &eqs,
+        0.0,
+        &guess,
+        &SteadyRequest::new(unknowns.clone(), conditions),
+    )?;
+    let (p_solved, q_solved) = (rest.x[unknowns[0]], rest.x[unknowns[3]]);
     let run = simulate(&mut eqs, &x0, &settings, &outputs, vec![]);
     if let Some(e) = &run.error {
         return Err(format!("the run stopped: {e}").into());
@@ -131,6 +163,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         p / 1e6,
         last[1],
         s_rest
+    );
+    println!(
+        "solved rest state (Newton, {} iterations): P_line {:.6} MPa, spring deflection {:.6} m",
+        rest.iterations,
+        p_solved / 1e6,
+        q_solved
     );
     for w in &run.watched {
         println!(

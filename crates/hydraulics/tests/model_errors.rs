@@ -30,11 +30,7 @@ fn valve_parameters_without_a_valve_are_refused() {
 
 #[test]
 fn hold_force_and_given_pressures_exclude_each_other() {
-    let e = lift_with(
-        r#"hold_force = "m*g""#,
-        r#"hold_force = "m*g", p_p0 = 1e6, p_r0 = 1e6"#,
-    )
-    .unwrap_err();
+    let e = lift_with(r#"p_p0 = "p_pre""#, r#"hold_force = "m*g", p_p0 = "p_pre""#).unwrap_err();
     assert_eq!(e.kind, ErrorKind::BadParameter, "{e}");
     assert!(e.message.contains("hold_force"), "{e}");
 }
@@ -47,8 +43,8 @@ fn geometry_is_checked_with_the_key_named() {
     // starting past the stroke end is allowed only with an end stop
     assert!(lift_with(r#"s0 = "s0""#, "s0 = 1.5").is_ok());
     let e = lift_with(
-        r#"s0 = "s0", beta = "beta", p_t = "p_t", hold_force = "m*g", x_v = "spool.out", p_s = "p_s", p_tr = "p_tr", alpha = "alpha", r_int = "r_l", k_stop = 1e9, c_stop = 5e6"#,
-        r#"s0 = 1.5, beta = "beta", p_t = "p_t", hold_force = "m*g", x_v = "spool.out", p_s = "p_s", p_tr = "p_tr", alpha = "alpha", r_int = "r_l""#,
+        r#"s0 = "s0", beta = "beta", p_t = "p_t", p_p0 = "p_pre", p_r0 = "p_pre", x_v = "spool.out", p_s = "p_s", p_tr = "p_tr", alpha = "alpha", r_int = "r_l", k_stop = 1e9, c_stop = 5e6"#,
+        r#"s0 = 1.5, beta = "beta", p_t = "p_t", p_p0 = "p_pre", p_r0 = "p_pre", x_v = "spool.out", p_s = "p_s", p_tr = "p_tr", alpha = "alpha", r_int = "r_l""#,
     )
     .unwrap_err();
     assert!(e.message.contains("s0"), "{e}");

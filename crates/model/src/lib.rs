@@ -47,6 +47,7 @@ pub mod load;
 pub mod overrides;
 pub mod registry;
 pub mod scene;
+pub mod steady;
 
 pub use error::{ErrorKind, ModelError};
 pub use load::{inspect, Check, CheckResult, Inspection, Model};
@@ -54,3 +55,4 @@ pub use registry::{
     BuildFn, Builder, Composite, CompositeFn, ElementSpec, KindInfo, RawValue, Registry,
 };
 pub use scene::{Choice, Scene, Switch};
+pub use steady::SteadyReport;

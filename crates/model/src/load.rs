@@ -593,6 +593,8 @@ pub struct Model {
     pub parameters: IndexMap<String, f64>,
     /// The scene switches the file declares (`[scene]`, [`crate::scene`]).
     pub scene: Scene,
+    /// The steady state solved for the start (`[initial.steady]`), if the file asks for one.
+    pub steady: Option<crate::steady::SteadyReport>,
     /// Notes from loading: things that load but were likely meant otherwise.
     notes: Vec<ModelError>,
     source: Source,
@@ -1100,6 +1102,10 @@ pub fn inspect(path: &Path, registry: &Registry, overrides: &[String]) -> Inspec
             out.order = eqs.order();
             match finish(p, eqs) {
                 Ok(m) => {
+                    // the start as the model runs it: `[initial]` and a solved steady start
+                    for (s, v) in out.states.iter_mut().zip(&m.x0) {
+                        s.1 = *v;
+                    }
                     out.notes = m.notes();
                     out.scene = m.scene;
                 }
@@ -1120,7 +1126,16 @@ fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
     } = p;
     // initial values
     let mut flat = Vec::new();
-    flatten("", &spec.initial, &mut flat);
+    let mut steady_spec = None;
+    for (k, v) in &spec.initial {
+        if k.get_ref() == "steady" && v.get_ref().is_table() {
+            steady_spec = Some(v);
+        } else {
+            let mut one = SpannedMap::default();
+            one.insert(k.clone(), v.clone());
+            flatten("", &one, &mut flat);
+        }
+    }
     for (name, value, span) in flat {
         let v = match &value {
             toml::Value::Float(f) => Some(*f),
@@ -1214,6 +1229,32 @@ fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
             )
             .hint("t_start < t_end, dt_out > 0, 0 < rtol < 1, atol > 0"));
     }
+    // a steady start ([initial.steady], crate::steady), from the values above
+    let steady = match steady_spec {
+        None => None,
+        Some(v) => {
+            let x0 = eqs.initial_state();
+            let report =
+                crate::steady::solve(v.get_ref(), &eqs, &parameters, settings.t_start, &x0)
+                    .map_err(|(message, hint)| {
+                        let e = source.err(ErrorKind::Settings, Some(&v.span()), message);
+                        match hint {
+                            Some(h) => e.hint(h),
+                            None => e,
+                        }
+                    })?;
+            if let Some(r) = &report {
+                for name in &r.kept {
+                    if let Some(i) = eqs.states().iter().position(|s| &s.name == name) {
+                        let value = r.solution.x[i];
+                        eqs.set_initial(name, value)
+                            .map_err(|e| source.err(ErrorKind::Settings, None, e.to_string()))?;
+                    }
+                }
+            }
+            report
+        }
+    };
     let (outputs, notes) = read_outputs(&spec.outputs, &source, &eqs)?;
     // checks
     let mut checks = Vec::new();
@@ -1269,6 +1310,7 @@ fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, ModelError> {
         checks,
         parameters,
         scene,
+        steady,
         notes,
         source,
     };

@@ -5,7 +5,7 @@
 //! [scene]
 //! modes1 = { set = "parameters.modes1", choices = [10, 5, 3, 0] }
 //! lumped = { set = "elements.crane.lumped_model", choices = ["springs", "rigid", "none"],
-//!            also = { none = ["parameters.hold_lumped=0"] } }
+//!            also = { none = ["parameters.m_extra=0"] } }
 //! ```
 //!
 //! Each switch names one value of the file (`set`, a `--set` key) and its `choices`, from
@@ -240,7 +240,7 @@ pub(crate) fn read(
                     let toml::Value::Array(list) = list else {
                         return Err(fail(
                             format!("`also.{}` must be a list of \"key=value\" strings", clip(k)),
-                            "e.g. also = { none = [\"parameters.hold_lumped=0\"] }",
+                            "e.g. also = { none = [\"parameters.m_extra=0\"] }",
                         ));
                     };
                     for o in list {
@@ -253,7 +253,7 @@ pub(crate) fn read(
                                         clip(k),
                                         clip(&o.to_string())
                                     ),
-                                    "e.g. also = { none = [\"parameters.hold_lumped=0\"] }",
+                                    "e.g. also = { none = [\"parameters.m_extra=0\"] }",
                                 ))
                             }
                         }
@@ -263,7 +263,7 @@ pub(crate) fn read(
             Some(_) => {
                 return Err(fail(
                     "`also` must be a table: choice = [\"key=value\", ...]".into(),
-                    "e.g. also = { none = [\"parameters.hold_lumped=0\"] }",
+                    "e.g. also = { none = [\"parameters.m_extra=0\"] }",
                 ))
             }
         }

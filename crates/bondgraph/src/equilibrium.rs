@@ -1,0 +1,620 @@
+//! Steady states as a solve: Newton's method on chosen unknown states and conditions.
+//!
+//! Some states are unknown (e.g. the chamber pressures that hold a load, a beam's modal
+//! coordinates under gravity); as many conditions fix them, each a state derivative
+//! (`mass.p.dot = 0`: an acceleration, or any rate, held at a value), a state itself, or any
+//! other variable of the equations (an effort, flow or signal). The other states keep their
+//! values. The conditions are solved by Newton's method with the exact Jacobian of
+//! [`StateEquations::jacobian`] (its rows for the derivative conditions, unit rows for the
+//! state conditions; central differences over the unknowns for other variables) and a
+//! backtracking (Armijo) line search on the sum of squared scaled residuals.
+//!
+//! **Scaling.** An unknown is measured in units of its scale c_j = max(|x_j|, nominal_j) at
+//! the start; a condition in units of its row scale s_i = max_j |∂r_i/∂x_j|·c_j there (what a
+//! change of one scale of the most effective unknown does to it). The scaled residual
+//! r_i/s_i is therefore the change of unknowns, in their scales, still needed; the solve
+//! stops when every scaled residual is below `tol`.
+//!
+//! A system without an equilibrium is refused ([`EquilibriumError`]): the counts differ, a
+//! condition depends on no unknown, the scaled Jacobian is singular (the unknowns of its
+//! null direction are named), or the line search cannot reduce the residuals (the largest
+//! ones are named).
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::equations::{Probe, StateEquations};
+
+/// One condition of a steady state.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Condition {
+    /// dx_i/dt = value (e.g. 0: the state is at rest).
+    Derivative {
+        /// State index.
+        state: usize,
+        /// Required rate.
+        value: f64,
+    },
+    /// x_i = value.
+    State {
+        /// State index.
+        state: usize,
+        /// Required value.
+        value: f64,
+    },
+    /// Any variable the equations compute (an effort, a flow, a signal: a [`Probe`]) held at
+    /// a value; its row of the Jacobian is a central difference over the unknowns.
+    Variable {
+        /// What to read.
+        probe: Probe,
+        /// Its name in reports (`lift_piston.mech.e`).
+        label: String,
+        /// Required value.
+        value: f64,
+    },
+}
+
+/// A steady-state request: the unknown states and as many conditions.
+#[derive(Clone, Debug)]
+pub struct SteadyRequest {
+    /// Indices of the unknown states.
+    pub unknowns: Vec<usize>,
+    /// The conditions, as many as unknowns.
+    pub conditions: Vec<Condition>,
+    /// Largest scaled residual accepted (default 1e-10).
+    pub tol: f64,
+    /// Most Newton iterations (default 50).
+    pub max_iterations: usize,
+}
+
+impl SteadyRequest {
+    /// A request with the default tolerance and iteration limit.
+    #[must_use]
+    pub fn new(unknowns: Vec<usize>, conditions: Vec<Condition>) -> Self {
+        Self {
+            unknowns,
+            conditions,
+            tol: 1e-10,
+            max_iterations: 50,
+        }
+    }
+}
+
+/// A solved steady state.
+#[derive(Clone, Debug)]
+pub struct Equilibrium {
+    /// The whole state vector, with the unknowns solved.
+    pub x: Vec<f64>,
+    /// Newton iterations taken.
+    pub iterations: usize,
+    /// Per condition: its name (`mass.p.dot = 0`), the residual in the condition's units, and
+    /// scaled by its row scale.
+    pub residuals: Vec<(String, f64, f64)>,
+}
+
+impl Equilibrium {
+    /// The largest scaled residual and its condition.
+    #[must_use]
+    pub fn worst(&self) -> Option<&(String, f64, f64)> {
+        self.residuals
+            .iter()
+            .max_by(|a, b| a.2.abs().total_cmp(&b.2.abs()))
+    }
+}
+
+/// Why a steady state could not be found.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum EquilibriumError {
+    /// The number of unknowns differs from the number of conditions.
+    #[error("{} unknowns ({}) but {} conditions ({}): name as many conditions as unknowns", unknowns.len(), unknowns.join(", "), conditions.len(), conditions.join(", "))]
+    CountMismatch {
+        /// The unknown states.
+        unknowns: Vec<String>,
+        /// The conditions.
+        conditions: Vec<String>,
+    },
+    /// A state or condition index is out of range, or an unknown is named twice.
+    #[error("invalid steady-state request: {0}")]
+    Invalid(String),
+    /// A condition depends on none of the unknowns at the start.
+    #[error("the condition `{condition}` (residual {residual:.3e}) depends on none of the unknowns {} at the start: name an unknown that moves it", unknowns.join(", "))]
+    Unaffected {
+        /// The condition.
+        condition: String,
+        /// Its residual at the start.
+        residual: f64,
+        /// The unknown states.
+        unknowns: Vec<String>,
+    },
+    /// The conditions do not determine the unknowns.
+    #[error("singular system: the conditions do not determine the unknowns {} (scaled Jacobian rank-deficient, smallest/largest singular value {ratio:.1e}); largest residuals: {}", unknowns.join(", "), show(residuals))]
+    Singular {
+        /// The unknowns of the null direction, largest share first.
+        unknowns: Vec<String>,
+        /// σ_min/σ_max of the scaled Jacobian.
+        ratio: f64,
+        /// The largest residuals (condition, residual, scaled).
+        residuals: Vec<(String, f64, f64)>,
+    },
+    /// Newton's method could not reduce the residuals: no equilibrium near the start.
+    #[error("no equilibrium found for the unknowns {} after {iterations} Newton iterations; largest residuals: {}", unknowns.join(", "), show(residuals))]
+    NoEquilibrium {
+        /// The unknown states.
+        unknowns: Vec<String>,
+        /// Iterations taken.
+        iterations: usize,
+        /// The largest residuals (condition, residual, scaled).
+        residuals: Vec<(String, f64, f64)>,
+    },
+}
+
+fn show(r: &[(String, f64, f64)]) -> String {
+    r.iter()
+        .map(|(n, v, s)| format!("{n}: {v:.3e} (scaled {s:.1e})"))
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+/// Name of a condition: `mass.p.dot = 0`, `spring.q = 0.01`.
+#[must_use]
+pub fn condition_name(eqs: &StateEquations, c: &Condition) -> String {
+    let name = |i: usize| eqs.states().get(i).map_or("?", |s| s.name.as_str());
+    match c {
+        Condition::Derivative { state, value } => format!("{}.dot = {value}", name(*state)),
+        Condition::State { state, value } => format!("{} = {value}", name(*state)),
+        Condition::Variable { label, value, .. } => format!("{label} = {value}"),
+    }
+}
+
+struct Problem<'a> {
+    eqs: &'a StateEquations,
+    t: f64,
+    req: &'a SteadyRequest,
+    dx: Vec<f64>,
+    jac: DMatrix<f64>,
+    row_scale: Vec<f64>,
+    col_scale: Vec<f64>,
+}
+
+impl Problem<'_> {
+    /// Residuals at x (unscaled).
+    fn residuals(&mut self, x: &[f64]) -> Vec<f64> {
+        let variables = self
+            .req
+            .conditions
+            .iter()
+            .any(|c| matches!(c, Condition::Variable { .. }));
+        if variables {
+            self.eqs.evaluate(self.t, x);
+        }
+        self.eqs.rhs(self.t, x, &mut self.dx);
+        self.req
+            .conditions
+            .iter()
+            .map(|c| match c {
+                Condition::Derivative { state, value } => self.dx[*state] - value,
+                Condition::State { state, value } => x[*state] - value,
+                Condition::Variable { probe, value, .. } => {
+                    self.eqs.read(*probe, self.t, x) - value
+                }
+            })
+            .collect()
+    }
+
+    /// ∂r/∂z at x (unscaled), conditions × unknowns.
+    fn jacobian(&mut self, x: &[f64]) -> DMatrix<f64> {
+        self.eqs.jacobian(self.t, x, &mut self.jac);
+        let (m, n) = (self.req.conditions.len(), self.req.unknowns.len());
+        let mut out = DMatrix::from_fn(m, n, |i, j| {
+            let u = self.req.unknowns[j];
+            match &self.req.conditions[i] {
+                Condition::Derivative { state, .. } => self.jac[(*state, u)],
+                Condition::State { state, .. } => {
+                    if *state == u {
+                        1.0
+                    } else {
+                        0.0
+                    }
+                }
+                Condition::Variable { .. } => 0.0,
+            }
+        });
+        // rows of variables: central differences, step 1e-7 of each unknown's scale
+        let rows: Vec<(usize, Probe)> = self
+            .req
+            .conditions
+            .iter()
+            .enumerate()
+            .filter_map(|(i, c)| match c {
+                Condition::Variable { probe, .. } => Some((i, *probe)),
+                _ => None,
+            })
+            .collect();
+        if !rows.is_empty() {
+            let mut xp = x.to_vec();
+            for j in 0..n {
+                let u = self.req.unknowns[j];
+                let h = 1e-7 * self.col_scale[j];
+                xp[u] = x[u] + h;
+                self.eqs.evaluate(self.t, &xp);
+                let plus: Vec<f64> = rows
+                    .iter()
+                    .map(|&(_, p)| self.eqs.read(p, self.t, &xp))
+                    .collect();
+                xp[u] = x[u] - h;
+                self.eqs.evaluate(self.t, &xp);
+                for (k, &(i, p)) in rows.iter().enumerate() {
+                    out[(i, j)] = (plus[k] - self.eqs.read(p, self.t, &xp)) / (2.0 * h);
+                }
+                xp[u] = x[u];
+            }
+        }
+        out
+    }
+
+    fn scaled(&self, r: &[f64]) -> Vec<f64> {
+        r.iter().zip(&self.row_scale).map(|(r, s)| r / s).collect()
+    }
+
+    fn report(&self, r: &[f64], worst_only: bool) -> Vec<(String, f64, f64)> {
+        let s = self.scaled(r);
+        let mut out: Vec<(String, f64, f64)> = self
+            .req
+            .conditions
+            .iter()
+            .enumerate()
+            .map(|(i, c)| (condition_name(self.eqs, c), r[i], s[i]))
+            .collect();
+        if worst_only {
+            out.sort_by(|a, b| b.2.abs().total_cmp(&a.2.abs()));
+            out.truncate(4);
+        }
+        out
+    }
+
+    fn names(&self) -> Vec<String> {
+        self.req
+            .unknowns
+            .iter()
+            .map(|&i| self.eqs.states()[i].name.clone())
+            .collect()
+    }
+}
+
+fn merit(s: &[f64]) -> f64 {
+    0.5 * s.iter().map(|v| v * v).sum::<f64>()
+}
+
+/// Solve for a steady state: the unknown states of `req` such that its conditions hold at
+/// time `t`, starting from `x0` (which also gives every other state).
+///
+/// # Returns
+/// The state vector with the unknowns solved and the residual of each condition, or an
+/// [`EquilibriumError`] naming the unknowns and the largest residuals.
+///
+/// # Complexity
+/// Per Newton iteration one Jacobian, one SVD of the m×m reduced Jacobian (O(m³)) and a few
+/// right-hand sides for the line search.
+pub fn solve_steady(
+    eqs: &StateEquations,
+    t: f64,
+    x0: &[f64],
+    req: &SteadyRequest,
+) -> Result<Equilibrium, EquilibriumError> {
+    let n = eqs.n_states();
+    let state_name = |i: usize| eqs.states()[i].name.clone();
+    if x0.len() != n {
+        return Err(EquilibriumError::Invalid(format!(
+            "the state vector has {} values, the equations {n} states",
+            x0.len()
+        )));
+    }
+    for (k, &u) in req.unknowns.iter().enumerate() {
+        if u >= n {
+            return Err(EquilibriumError::Invalid(format!("no state {u}")));
+        }
+        if req.unknowns[..k].contains(&u) {
+            return Err(EquilibriumError::Invalid(format!(
+                "`{}` is named twice as an unknown",
+                state_name(u)
+            )));
+        }
+    }
+    for c in &req.conditions {
+        if let Condition::Derivative { state, .. } | Condition::State { state, .. } = c {
+            if *state >= n {
+                return Err(EquilibriumError::Invalid(format!("no state {state}")));
+            }
+        }
+    }
+    if req.unknowns.len() != req.conditions.len() {
+        return Err(EquilibriumError::CountMismatch {
+            unknowns: req.unknowns.iter().map(|&i| state_name(i)).collect(),
+            conditions: req
+                .conditions
+                .iter()
+                .map(|c| condition_name(eqs, c))
+                .collect(),
+        });
+    }
+    let mut x = x0.to_vec();
+    let m = req.unknowns.len();
+    if m == 0 {
+        return Ok(Equilibrium {
+            x,
+            iterations: 0,
+            residuals: Vec::new(),
+        });
+    }
+    let mut p = Problem {
+        eqs,
+        t,
+        req,
+        dx: vec![0.0; n],
+        jac: DMatrix::zeros(n, n),
+        row_scale: vec![1.0; m],
+        col_scale: req
+            .unknowns
+            .iter()
+            .map(|&i| {
+                let c = x0[i].abs().max(eqs.states()[i].nominal.abs());
+                if c > 0.0 && c.is_finite() {
+                    c
+                } else {
+                    1.0
+                }
+            })
+            .collect(),
+    };
+    // Row scales from the Jacobian at the start.
+    let j0 = p.jacobian(&x);
+    let r0 = p.residuals(&x);
+    for i in 0..m {
+        let s = (0..m)
+            .map(|j| (j0[(i, j)] * p.col_scale[j]).abs())
+            .fold(0.0, f64::max);
+        if !(s > 0.0 && s.is_finite()) {
+            return Err(EquilibriumError::Unaffected {
+                condition: condition_name(eqs, &req.conditions[i]),
+                residual: r0[i],
+                unknowns: p.names(),
+            });
+        }
+        p.row_scale[i] = s;
+    }
+    let mut r = r0;
+    for it in 0..=req.max_iterations {
+        let s = p.scaled(&r);
+        let worst = s.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        if worst <= req.tol {
+            let residuals = p.report(&r, false);
+            return Ok(Equilibrium {
+                x,
+                iterations: it,
+                residuals,
+            });
+        }
+        if it == req.max_iterations || !worst.is_finite() {
+            break;
+        }
+        // Scaled Newton step: A·Δ = −s with A_ij = J_ij·c_j/s_i.
+        let j = p.jacobian(&x);
+        let a = DMatrix::from_fn(m, m, |i, k| j[(i, k)] * p.col_scale[k] / p.row_scale[i]);
+        let svd = a.svd(true, true);
+        let (smax, smin, kmin) = svd.singular_values.iter().enumerate().fold(
+            (0.0f64, f64::INFINITY, 0),
+            |(mx, mn, k), (i, &v)| {
+                if v < mn {
+                    (mx.max(v), v, i)
+                } else {
+                    (mx.max(v), mn, k)
+                }
+            },
+        );
+        if smin.is_nan() || smin <= 1e-13 * smax {
+            let null: Vec<f64> = svd
+                .v_t
+                .as_ref()
+                .map(|vt| vt.row(kmin).iter().copied().collect())
+                .unwrap_or_default();
+            let big = null.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            let mut named: Vec<(f64, String)> = null
+                .iter()
+                .enumerate()
+                .filter(|(_, v)| v.abs() >= 0.1 * big)
+                .map(|(k, v)| (v.abs(), state_name(req.unknowns[k])))
+                .collect();
+            named.sort_by(|a, b| b.0.total_cmp(&a.0));
+            return Err(EquilibriumError::Singular {
+                unknowns: named.into_iter().map(|(_, n)| n).collect(),
+                ratio: if smax > 0.0 { smin / smax } else { 0.0 },
+                residuals: p.report(&r, true),
+            });
+        }
+        let rhs = DVector::from_iterator(m, s.iter().map(|v| -v));
+        let Ok(delta) = svd.solve(&rhs, 0.0) else {
+            break;
+        };
+        // Backtracking line search on ½‖s‖².
+        let phi0 = merit(&s);
+        let mut alpha = 1.0;
+        let accepted = loop {
+            let mut trial = x.clone();
+            for (k, &u) in req.unknowns.iter().enumerate() {
+                trial[u] += alpha * delta[k] * p.col_scale[k];
+            }
+            let rt = p.residuals(&trial);
+            let phi = merit(&p.scaled(&rt));
+            if phi.is_finite() && phi <= (1.0 - 1e-4 * alpha) * phi0 {
+                break Some((trial, rt));
+            }
+            alpha *= 0.5;
+            if alpha < 1e-10 {
+                break None;
+            }
+        };
+        match accepted {
+            Some((trial, rt)) => {
+                x = trial;
+                r = rt;
+            }
+            None => {
+                return Err(EquilibriumError::NoEquilibrium {
+                    unknowns: p.names(),
+                    iterations: it + 1,
+                    residuals: p.report(&r, true),
+                })
+            }
+        }
+    }
+    Err(EquilibriumError::NoEquilibrium {
+        unknowns: p.names(),
+        iterations: req.max_iterations,
+        residuals: p.report(&r, true),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::Resistor;
+    use crate::{assign_causality, BondGraph, Capacitor, EffortSource, Inertia, OneJunction};
+
+    /// A mass on a spring under a constant force F: at rest the spring holds F, q = F/k.
+    fn hanging(force: f64, k: f64) -> StateEquations {
+        let mut g = BondGraph::new();
+        g.add("force", EffortSource::new(force)).unwrap();
+        g.add("v", OneJunction).unwrap();
+        g.add("mass", Inertia::new(2.0, 0.0).unwrap()).unwrap();
+        g.add("spring", Capacitor::new(1.0 / k, 0.0).unwrap())
+            .unwrap();
+        g.add("damper", Resistor::new(3.0).unwrap()).unwrap();
+        for (a, b) in [
+            ("force", "v"),
+            ("v", "mass"),
+            ("v", "spring"),
+            ("v", "damper"),
+        ] {
+            g.connect_names(a, b).unwrap();
+        }
+        StateEquations::new(assign_causality(g).unwrap()).unwrap()
+    }
+
+    fn index(eqs: &StateEquations, name: &str) -> usize {
+        eqs.states().iter().position(|s| s.name == name).unwrap()
+    }
+
+    #[test]
+    fn spring_preload_is_force_over_stiffness() {
+        let eqs = hanging(-98.1, 5e4);
+        let (q, p) = (index(&eqs, "spring.q"), index(&eqs, "mass.p"));
+        let req = SteadyRequest::new(
+            vec![q],
+            vec![Condition::Derivative {
+                state: p,
+                value: 0.0,
+            }],
+        );
+        let eq = solve_steady(&eqs, 0.0, &eqs.initial_state(), &req).unwrap();
+        let exact = -98.1 / 5e4;
+        assert!(
+            (eq.x[q] - exact).abs() <= 1e-12 * exact.abs(),
+            "{}",
+            eq.x[q]
+        );
+        assert!(eq.iterations <= 2, "linear: {}", eq.iterations);
+        assert_eq!(eq.residuals[0].0, "mass.p.dot = 0");
+    }
+
+    #[test]
+    fn a_state_condition_and_a_count_mismatch() {
+        let eqs = hanging(-10.0, 100.0);
+        let (q, p) = (index(&eqs, "spring.q"), index(&eqs, "mass.p"));
+        let req = SteadyRequest::new(
+            vec![q, p],
+            vec![
+                Condition::Derivative {
+                    state: p,
+                    value: 0.0,
+                },
+                Condition::State {
+                    state: p,
+                    value: 0.5,
+                },
+            ],
+        );
+        // mass.p = 0.5 moves at v = 0.25: the damper adds 0.75 N, the spring holds the rest
+        let eq = solve_steady(&eqs, 0.0, &eqs.initial_state(), &req).unwrap();
+        assert!((eq.x[p] - 0.5).abs() < 1e-14);
+        assert!((eq.x[q] - (-10.0 - 0.75) / 100.0).abs() < 1e-14);
+        let bad = SteadyRequest::new(vec![q, p], req.conditions[..1].to_vec());
+        let e = solve_steady(&eqs, 0.0, &eqs.initial_state(), &bad).unwrap_err();
+        assert!(matches!(e, EquilibriumError::CountMismatch { .. }), "{e}");
+        assert!(e
+            .to_string()
+            .contains("2 unknowns (spring.q, mass.p) but 1 conditions"));
+    }
+
+    #[test]
+    fn a_force_nothing_can_balance_is_refused_naming_residuals() {
+        // F(q) = −(1 + q²) against a unit spring: ṗ = −(q² + q + 1) < 0 for every q.
+        let mut g = BondGraph::new();
+        let law = crate::Param::modulated(vec!["spring.q".into()], |_, u| -(1.0 + u[0] * u[0]));
+        g.add("force", EffortSource::new(law)).unwrap();
+        g.add("v", OneJunction).unwrap();
+        g.add("mass", Inertia::new(1.0, 0.0).unwrap()).unwrap();
+        g.add("spring", Capacitor::new(1.0, 0.0).unwrap()).unwrap();
+        for (a, b) in [("force", "v"), ("v", "mass"), ("v", "spring")] {
+            g.connect_names(a, b).unwrap();
+        }
+        let eqs = StateEquations::new(assign_causality(g).unwrap()).unwrap();
+        let (q, p) = (index(&eqs, "spring.q"), index(&eqs, "mass.p"));
+        let req = SteadyRequest::new(
+            vec![q],
+            vec![Condition::Derivative {
+                state: p,
+                value: 0.0,
+            }],
+        );
+        let e = solve_steady(&eqs, 0.0, &eqs.initial_state(), &req).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                EquilibriumError::NoEquilibrium { .. } | EquilibriumError::Singular { .. }
+            ),
+            "{e}"
+        );
+        let text = e.to_string();
+        assert!(
+            text.contains("spring.q") && text.contains("mass.p.dot = 0"),
+            "{text}"
+        );
+    }
+
+    #[test]
+    fn an_unknown_no_condition_depends_on_is_singular() {
+        let eqs = hanging(-1.0, 1.0);
+        let (q, p) = (index(&eqs, "spring.q"), index(&eqs, "mass.p"));
+        // two conditions on ṗ only: rank 1
+        let req = SteadyRequest::new(
+            vec![q, p],
+            vec![
+                Condition::Derivative {
+                    state: p,
+                    value: 0.0,
+                },
+                Condition::Derivative {
+                    state: p,
+                    value: 0.0,
+                },
+            ],
+        );
+        let e = solve_steady(&eqs, 0.0, &eqs.initial_state(), &req).unwrap_err();
+        let EquilibriumError::Singular { unknowns, .. } = &e else {
+            panic!("{e}")
+        };
+        assert!(!unknowns.is_empty(), "{e}");
+        assert!(e.to_string().contains("mass.p.dot = 0"), "{e}");
+    }
+}
