@@ -354,8 +354,35 @@ fn report(label: &str, n: usize, jacs: &[Vec<f64>], hs: &[f64]) {
     }
 }
 
+/// `LU_PROFILE=real|complex`: factorise the first file's Jacobians for 3 s, for `perf`.
+fn profile(what: &str, path: &str) {
+    let (n, jacs) = read_jacobians(path);
+    let (mut r, mut c) = (new::RealLu::new(n), new::ComplexLu::new(n));
+    let start = Instant::now();
+    let mut calls = 0;
+    while start.elapsed().as_secs_f64() < 3.0 {
+        for jac in &jacs {
+            for h in [1e-4, 1e-3, 1e-2] {
+                if what == "real" {
+                    r.set_shifted(GAMMA / h, jac);
+                    r.factor().unwrap();
+                } else {
+                    c.set_shifted(Complex::new(ALPHA / h, BETA / h), jac);
+                    c.factor().unwrap();
+                }
+                calls += 1;
+            }
+        }
+    }
+    println!("{what}: {:.2} µs per factorisation", 3e6 / f64::from(calls));
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
+    if let (Ok(what), Some(path)) = (std::env::var("LU_PROFILE"), args.first()) {
+        profile(&what, path);
+        return;
+    }
     for path in &args {
         let (n, jacs) = read_jacobians(path);
         report("crane", n, &jacs, &[1e-4, 1e-3, 1e-2]);
