@@ -6,6 +6,7 @@ use bg_model::Registry;
 
 pub mod bench;
 pub mod plot;
+pub mod sweep;
 
 /// Every element kind this build knows: the core kinds plus the domain crates'.
 #[must_use]

@@ -89,6 +89,22 @@ enum Command {
         #[arg(long, value_name = "DIR")]
         plots: Option<PathBuf>,
     },
+    /// Run a model many times over a grid or a Latin-hypercube sample of values, in
+    /// parallel, and write one summary row per run (docs/sweeps.md). Started again on the
+    /// same folder, it skips the runs already done.
+    Sweep {
+        /// The model file.
+        model: PathBuf,
+        /// The sweep spec: [parameters] to vary, [metrics] to keep, [sweep] design.
+        #[arg(long, value_name = "SWEEP.toml")]
+        spec: PathBuf,
+        /// Worker threads (default: one per core).
+        #[arg(short, long, default_value_t = 0)]
+        jobs: usize,
+        /// Output folder for summary.csv (and runs/ with keep_runs).
+        #[arg(short, long, default_value = "out/sweep")]
+        output: PathBuf,
+    },
     /// Check a model: list elements, bonds with causal strokes, states and problems.
     Check {
         /// The model file.
@@ -227,6 +243,12 @@ fn dispatch(command: Command) -> ExitCode {
             }
         }
         Command::Check { model, set } => check(&model, &set),
+        Command::Sweep {
+            model,
+            spec,
+            jobs,
+            output,
+        } => sweep(&model, &spec, jobs, output),
         Command::Kinds => {
             for (k, info) in registry().kinds() {
                 say!("{k:<24} {}", info.summary);
@@ -267,6 +289,75 @@ fn dispatch(command: Command) -> ExitCode {
             t_end,
             set: &set,
         }),
+    }
+}
+
+fn sweep(model: &Path, spec: &Path, jobs: usize, out_dir: PathBuf) -> ExitCode {
+    use bg_sim::sweep::{parse_spec, sweep, Options};
+    let shown = spec.display().to_string();
+    let parsed = std::fs::read_to_string(spec)
+        .map_err(|e| format!("{shown}: {e}"))
+        .and_then(|t| parse_spec(&shown, &t).map_err(|e| e.to_string()));
+    let spec = match parsed {
+        Ok(s) => s,
+        Err(e) => {
+            tell!("error: {e}");
+            return ExitCode::from(BAD_INPUT);
+        }
+    };
+    let opts = Options {
+        jobs,
+        out_dir,
+        interrupt: Some(interrupt_on_signals()),
+    };
+    match sweep(model, &spec, registry, &opts) {
+        Ok(s) => {
+            say!(
+                "{} runs: {} done now ({} ok, {} not ok), {} already in the summary{}",
+                s.total,
+                s.ok + s.not_ok,
+                s.ok,
+                s.not_ok,
+                s.skipped,
+                if s.interrupted > 0 {
+                    format!(
+                        ", {} left by an interrupt (run again to resume)",
+                        s.interrupted
+                    )
+                } else {
+                    String::new()
+                }
+            );
+            say!(
+                "wall time {:.3} s; the runs' own times add up to {:.3} s ({:.2}× on {} threads)",
+                s.wall_s,
+                s.run_s,
+                if s.wall_s > 0.0 {
+                    s.run_s / s.wall_s
+                } else {
+                    0.0
+                },
+                rayon_threads(jobs)
+            );
+            say!("summary: {}", s.path.display());
+            if s.interrupted > 0 || s.not_ok > 0 {
+                ExitCode::from(FAILED)
+            } else {
+                ExitCode::SUCCESS
+            }
+        }
+        Err(e) => {
+            tell!("error: {e}");
+            ExitCode::from(BAD_INPUT)
+        }
+    }
+}
+
+fn rayon_threads(jobs: usize) -> usize {
+    if jobs > 0 {
+        jobs
+    } else {
+        std::thread::available_parallelism().map_or(1, std::num::NonZero::get)
     }
 }
 
