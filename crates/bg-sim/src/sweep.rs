@@ -162,6 +162,8 @@ pub struct Metric {
     pub expr: Expr,
     /// The level of `first_crossing`.
     pub level: f64,
+    /// As written in the spec.
+    pub source: String,
 }
 
 /// A parsed sweep spec.
@@ -492,6 +494,7 @@ pub fn parse_metric(name: &str, src: &str) -> Result<Metric, String> {
         reduction,
         expr,
         level,
+        source: src.to_owned(),
     })
 }
 
