@@ -105,6 +105,33 @@ enum Command {
         #[arg(short, long, default_value = "out/sweep")]
         output: PathBuf,
     },
+    /// Draw one column of a sweep's summary over two swept parameters as filled contours
+    /// (PNG); runs without a value are crosses.
+    SweepPlot {
+        /// The summary.csv of `bg-sim sweep`.
+        summary: PathBuf,
+        /// The column along x (a swept parameter, e.g. parameters.m3).
+        #[arg(long)]
+        x: String,
+        /// The column along y.
+        #[arg(long)]
+        y: String,
+        /// The column to map (a metric).
+        #[arg(long)]
+        z: String,
+        /// Divide x, y and z by these factors for the labels (e.g. 1000 for t, kN).
+        #[arg(long, value_delimiter = ',', default_value = "1,1,1")]
+        scale: Vec<f64>,
+        /// Axis labels x,y,z (default: the column names).
+        #[arg(long, value_delimiter = ',')]
+        labels: Option<Vec<String>>,
+        /// Title.
+        #[arg(long, default_value = "")]
+        title: String,
+        /// The PNG to write.
+        #[arg(short, long, default_value = "out/sweep.png")]
+        output: PathBuf,
+    },
     /// Check a model: list elements, bonds with causal strokes, states and problems.
     Check {
         /// The model file.
@@ -243,6 +270,23 @@ fn dispatch(command: Command) -> ExitCode {
             }
         }
         Command::Check { model, set } => check(&model, &set),
+        Command::SweepPlot {
+            summary,
+            x,
+            y,
+            z,
+            scale,
+            labels,
+            title,
+            output,
+        } => sweep_plot(
+            &summary,
+            [&x, &y, &z],
+            &scale,
+            labels.as_deref(),
+            &title,
+            &output,
+        ),
         Command::Sweep {
             model,
             spec,
@@ -351,6 +395,82 @@ fn sweep(model: &Path, spec: &Path, jobs: usize, out_dir: PathBuf) -> ExitCode {
             ExitCode::from(BAD_INPUT)
         }
     }
+}
+
+fn sweep_plot(
+    summary: &Path,
+    cols: [&String; 3],
+    scale: &[f64],
+    labels: Option<&[String]>,
+    title: &str,
+    output: &Path,
+) -> ExitCode {
+    match sweep_map(summary, cols, scale) {
+        Ok(map) => {
+            let name = |k: usize| {
+                labels
+                    .and_then(|l| l.get(k))
+                    .map_or(cols[k].as_str(), String::as_str)
+            };
+            match bg_sim::plot::contour(title, (name(0), name(1), name(2)), &map, output) {
+                Ok(p) => {
+                    say!("wrote {}", p.display());
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    tell!("error: {e}");
+                    ExitCode::from(FAILED)
+                }
+            }
+        }
+        Err(e) => {
+            tell!("error: {e}");
+            ExitCode::from(BAD_INPUT)
+        }
+    }
+}
+
+/// The grid of one summary column over two others; runs whose value is empty are `None`.
+fn sweep_map(
+    summary: &Path,
+    cols: [&String; 3],
+    scale: &[f64],
+) -> Result<bg_sim::plot::Map, String> {
+    let (head, rows) = bg_sim::sweep::read_summary(summary).map_err(|e| e.to_string())?;
+    let mut idx = [0usize; 3];
+    for (k, c) in cols.iter().enumerate() {
+        idx[k] = head.iter().position(|h| h == *c).ok_or_else(|| {
+            format!(
+                "{}: no column `{c}`; columns: {}",
+                summary.display(),
+                head.join(", ")
+            )
+        })?;
+    }
+    if scale.len() != 3 || scale.iter().any(|s| !s.is_finite() || *s == 0.0) {
+        return Err("--scale takes three finite, non-zero factors: x,y,z".into());
+    }
+    let num = |r: &[String], k: usize| r.get(idx[k]).and_then(|v| v.parse::<f64>().ok());
+    let axis = |k: usize| {
+        let mut v: Vec<f64> = rows.iter().filter_map(|r| num(r, k)).collect();
+        v.sort_by(f64::total_cmp);
+        v.dedup();
+        v
+    };
+    let (xs, ys) = (axis(0), axis(1));
+    let mut z = vec![vec![None; ys.len()]; xs.len()];
+    for r in &rows {
+        if let (Some(x), Some(y), v) = (num(r, 0), num(r, 1), num(r, 2)) {
+            let i = xs.partition_point(|&a| a < x);
+            let j = ys.partition_point(|&a| a < y);
+            z[i][j] = v.map(|v| v / scale[2]);
+        }
+    }
+    Ok(bg_sim::plot::Map {
+        x: xs.iter().map(|v| v / scale[0]).collect(),
+        y: ys.iter().map(|v| v / scale[1]).collect(),
+        z,
+    })
 }
 
 fn rayon_threads(jobs: usize) -> usize {

@@ -134,6 +134,43 @@ fn a_resumed_sweep_skips_the_runs_already_done() {
 }
 
 #[test]
+fn sweep_plot_draws_a_png_of_a_grid() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = run(
+        "[parameters]\nk = [5.0, 10.0, 40.0]\nc = [0.2, 0.5]\n[metrics]\nv_rms = \"rms(v)\"\n",
+        dir.path(),
+    );
+    let png = dir.path().join("map.png");
+    let o = Command::new(env!("CARGO_BIN_EXE_bg-sim"))
+        .arg("sweep-plot")
+        .arg(&s.path)
+        .args([
+            "--x",
+            "parameters.k",
+            "--y",
+            "parameters.c",
+            "--z",
+            "v_rms",
+            "-o",
+        ])
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[1..4], b"PNG");
+    // a column the summary does not have is bad input, with the columns it has
+    let o = Command::new(env!("CARGO_BIN_EXE_bg-sim"))
+        .arg("sweep-plot")
+        .arg(&s.path)
+        .args(["--x", "parameters.k", "--y", "parameters.m", "--z", "v_rms"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no column `parameters.m`"));
+}
+
+#[test]
 fn cli_sweep_writes_the_summary_and_keeps_runs() {
     let dir = tempfile::tempdir().unwrap();
     let spec = dir.path().join("s.toml");
@@ -168,6 +205,26 @@ fn cli_sweep_writes_the_summary_and_keeps_runs() {
         assert!((f - k * 0.01).abs() < 1e-12, "{f}");
     }
     assert_eq!(std::fs::read_dir(out.join("runs")).unwrap().count(), 2);
+
+    // sweep-plot needs two values per axis: one axis of one value is refused, named
+    let png = dir.path().join("map.png");
+    let o = Command::new(env!("CARGO_BIN_EXE_bg-sim"))
+        .arg("sweep-plot")
+        .arg(out.join("summary.csv"))
+        .args([
+            "--x",
+            "parameters.k",
+            "--y",
+            "simulation.t_end",
+            "--z",
+            "F_peak",
+            "-o",
+        ])
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("2 × 2"));
 
     // a bad spec is bad input, named
     std::fs::write(
