@@ -248,3 +248,32 @@ fn cli_sweep_writes_the_summary_and_keeps_runs() {
         "{stderr}"
     );
 }
+
+/// The spec blocks of docs/sweeps.md (fenced ```` ```toml sweep-spec ````) and the crane
+/// study's spec parse, and their grids have the size the doc says.
+#[test]
+fn the_documented_specs_parse() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let doc = std::fs::read_to_string(root.join("docs/sweeps.md")).unwrap();
+    let mut blocks = Vec::new();
+    let mut current: Option<String> = None;
+    for line in doc.lines() {
+        match (&mut current, line.trim()) {
+            (None, "```toml sweep-spec") => current = Some(String::new()),
+            (Some(_), "```") => blocks.extend(current.take()),
+            (Some(b), l) => {
+                b.push_str(l);
+                b.push('\n');
+            }
+            _ => {}
+        }
+    }
+    assert!(!blocks.is_empty());
+    for (i, b) in blocks.iter().enumerate() {
+        let s = parse_spec(&format!("docs/sweeps.md block {}", i + 1), b).unwrap();
+        assert!(!bg_sim::sweep::points(&s).is_empty());
+    }
+    let crane = std::fs::read_to_string(root.join("docs/sweeps/crane.toml")).unwrap();
+    let s = parse_spec("docs/sweeps/crane.toml", &crane).unwrap();
+    assert_eq!(bg_sim::sweep::points(&s).len(), 55);
+}
