@@ -94,3 +94,26 @@ def test_dask_sweep_on_a_local_cluster_with_two_workers(tmp_path):
         assert len(client.scheduler_info()["workers"]) == 2
     check_rows(df)
     assert list(df["index"]) == list(range(8))
+
+
+def test_the_python_blocks_of_docs_sweeps_run(tmp_path, monkeypatch):
+    """docs/sweeps.md's examples, run as written (the crane, its 55-run sweep, Dask)."""
+    root = MODELS.parent
+    pytest.importorskip("distributed")
+    text = (root / "docs" / "sweeps.md").read_text()
+    blocks = [b.split("```", 1)[0] for b in text.split("```python\n")[1:]]
+    assert len(blocks) == 2
+    # relative paths as in the doc, the outputs in a temporary folder
+    for name in ("models", "docs"):
+        (tmp_path / name).symlink_to(root / name)
+    monkeypatch.chdir(tmp_path)
+    scope: dict = {}
+    for b in blocks:
+        exec(compile(b, "docs/sweeps.md", "exec"), scope)
+    assert scope["summary"].attrs["sweep"]["total"] == 55
+    assert len(scope["df"]) == 55
+    # the Dask rows and the local ones agree run by run
+    local = scope["summary"].set_index("run")
+    for _, r in scope["df"].iterrows():
+        if r["status"] in ("ok", "check-failed"):
+            assert r["F_c1_max"] == pytest.approx(local.loc[r["run"], "F_c1_max"], rel=1e-12)
