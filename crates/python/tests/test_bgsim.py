@@ -117,3 +117,14 @@ def test_the_python_blocks_of_docs_sweeps_run(tmp_path, monkeypatch):
     for _, r in scope["df"].iterrows():
         if r["status"] in ("ok", "check-failed"):
             assert r["F_c1_max"] == pytest.approx(local.loc[r["run"], "F_c1_max"], rel=1e-12)
+
+
+def test_a_run_that_stops_early_raises_with_its_partial_rows():
+    # l_d = 6.5 m drives cylinder 1's piston past its 2.7 m stroke at about t = 5 s
+    crane = bgsim.load(MODELS / "knuckle_boom.toml", set={"m3": 2000.0, "l_d": 6.5})
+    with pytest.raises(bgsim.RunError) as e:
+        crane.run()
+    assert "upper limit 2.7" in str(e.value)
+    partial = e.value.partial
+    assert 4.0 < partial["t"].iloc[-1] < 6.0
+    assert isinstance(e.value, bgsim.BgSimError)
