@@ -1,6 +1,7 @@
 //! The `bg-sim` front end as a library: the registry of every element kind this build
 //! knows, shared by the CLI and the workspace tests, and the figures of a results CSV
-//! ([`plot`]). No physics lives here.
+//! ([`plot`]), and sweeps: many runs of one model in parallel, one summary row each
+//! ([`sweep`]). No physics lives here.
 
 use bg_model::Registry;
 
