@@ -360,6 +360,17 @@ pub fn parse_spec(file: &str, text: &str) -> Result<Spec, SweepError> {
             metrics.push(parse_metric(name, src).map_err(|m| err(file, m))?);
         }
     }
+    if design == Design::Grid {
+        if let Some((k, _)) = parameters
+            .iter()
+            .find(|(_, v)| matches!(v, Values::Range { n: 0, .. }))
+        {
+            return Err(err(
+                file,
+                format!("`{k}`: a range in a grid needs n, the number of values"),
+            ));
+        }
+    }
     let spec = Spec {
         parameters,
         design,
@@ -1075,6 +1086,8 @@ mod tests {
         assert_eq!(p.len(), 6);
         assert_eq!(p[1].overrides(), ["parameters.k=1.0", "parameters.c=0.5"]);
         assert_eq!(p[3].overrides(), ["parameters.k=2.0", "parameters.c=0.0"]);
+        let e = parse_spec("s", "[parameters]\nc = { from = 0.0, to = 1.0 }\n").unwrap_err();
+        assert!(e.message.contains("needs n"), "{e}");
     }
 
     #[test]
