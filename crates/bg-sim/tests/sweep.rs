@@ -277,3 +277,74 @@ fn the_documented_specs_parse() {
     let s = parse_spec("docs/sweeps/crane.toml", &crane).unwrap();
     assert_eq!(bg_sim::sweep::points(&s).len(), 55);
 }
+
+/// Ctrl-C during a sweep: the runs under way stop and are not recorded, the finished ones
+/// stay in summary.csv, the exit status is 1; the same command again does only the rest.
+#[test]
+fn an_interrupted_sweep_resumes_where_it_stopped() {
+    let dir = tempfile::tempdir().unwrap();
+    let spec = dir.path().join("s.toml");
+    // 20 runs of 5000 s, about 0.15 s each here: the signal comes after the first two rows,
+    // well before the other 18 (about 1.3 s on two threads)
+    std::fs::write(
+        &spec,
+        "[parameters]\nk = { from = 5.0, to = 50.0, n = 20 }\n\"simulation.t_end\" = 5000.0\n\
+         [metrics]\nx_end = \"final(x)\"\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let sweep = || {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_bg-sim"));
+        c.arg("sweep")
+            .arg(model("mass_spring_damper"))
+            .arg("--spec")
+            .arg(&spec)
+            .arg("-o")
+            .arg(&out)
+            .args(["-j", "2"]);
+        c
+    };
+    let summary = out.join("summary.csv");
+    let child = sweep()
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    let done = |p: &Path| {
+        std::fs::read_to_string(p)
+            .map(|t| t.lines().count().saturating_sub(1))
+            .unwrap_or(0)
+    };
+    while done(&summary) < 2 {
+        assert!(start.elapsed().as_secs() < 120, "no rows after 120 s");
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    assert!(Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap()
+        .success());
+    let o = child.wait_with_output().unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let kept = done(&summary);
+    assert!((2..20).contains(&kept), "{kept} rows: {stdout}");
+    assert_eq!(o.status.code(), Some(1), "{stdout}");
+    assert!(
+        stdout.contains(&format!("{} left by an interrupt", 20 - kept)),
+        "{stdout}"
+    );
+    let (head, rows) = read_summary(&summary).unwrap();
+    assert!(
+        rows.iter().all(|r| r[col(&head, "status")] == "ok"),
+        "an interrupted run was recorded: {rows:?}"
+    );
+    let o = sweep().output().unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{stdout}");
+    assert!(
+        stdout.contains(&format!("20 runs: {} done now", 20 - kept))
+            && stdout.contains(&format!("{kept} already in the summary")),
+        "{stdout}"
+    );
+    assert_eq!(read_summary(&summary).unwrap().1.len(), 20);
+}
