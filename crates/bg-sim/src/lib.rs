@@ -1,8 +1,9 @@
 //! The `bg-sim` front end as a library: the registry of every element kind this build
 //! knows, shared by the CLI and the workspace tests, the figures of a results CSV
 //! ([`plot`]), the speed–accuracy measurements of `bench` ([`bench`]), the scene search
-//! of `reduce` ([`reduce`]) and the time-scale report of `bg-sim modes` ([`modes`]). No
-//! physics lives here.
+//! of `reduce` ([`reduce`]), the time-scale report of `bg-sim modes` ([`modes`]) and
+//! sweeps: many runs of one model in parallel, one summary row each ([`sweep`]). No physics
+//! lives here.
 
 use bg_model::Registry;
 
@@ -10,6 +11,7 @@ pub mod bench;
 pub mod modes;
 pub mod plot;
 pub mod reduce;
+pub mod sweep;
 
 /// Every element kind this build knows: the core kinds plus the domain crates'.
 #[must_use]
