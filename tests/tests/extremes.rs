@@ -445,7 +445,8 @@ fn loose_and_tight_tolerances() {
         .zip(&b)
         .fold(0.0_f64, |w, (x, y)| w.max((x - y).abs()));
     assert!(worst < 1e-2 * 0.4, "l1 differs by {worst} m");
-    assert!(tight.wall > loose.wall);
+    // more work for the tighter tolerance (counted, not timed: timing belongs to benchmarks)
+    assert!(tight.out.stats.steps > loose.out.stats.steps);
 }
 
 #[test]
