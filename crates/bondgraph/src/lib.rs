@@ -49,10 +49,12 @@
 //! time constant with the participation of each state ([`modes`](mod@modes) module).
 //!
 //! ## Simulation
-//! [`simulate`] integrates with diffsol ([`Method`]: BDF, ESDIRK34, TR-BDF2, Tsit45), with
-//! output times, scheduled [`Event`]s and [`Statistics`], and keeps the rows computed when it
-//! fails. [`radau`] is a standalone Radau IIA (order 5) integrator: [`Radau5`] over an
-//! [`OdeSystem`], stepped towards stop times, with dense output and restarts.
+//! [`simulate`] integrates with every [`Method`] behind one solver interface — our Radau IIA
+//! (order 5, the default) and diffsol's BDF, ESDIRK34, TR-BDF2, Tsit45 — with the exact
+//! Jacobian ([`StateEquations::jacobian`]), output times, scheduled [`Event`]s, limits and
+//! [`Statistics`], and keeps the rows computed when it fails. [`radau`] is the standalone
+//! Radau IIA integrator: [`Radau5`] over an [`OdeSystem`], stepped towards stop times, with
+//! dense output and restarts.
 
 pub mod bond;
 pub mod causality;
