@@ -1,6 +1,6 @@
 //! The `bg-sim` front end as a library: the registry of every element kind this build
 //! knows, shared by the CLI and the workspace tests, the figures of a results CSV
-//! ([`plot`]), the speed–accuracy measurements of `bench` ([`bench`]), the scene search
+//! ([`plot`]), the speed–accuracy measurements of `bench` ([`bench`](mod@bench)), the scene search
 //! of `reduce` ([`reduce`]), the time-scale report of `bg-sim modes` ([`modes`]) and
 //! sweeps: many runs of one model in parallel, one summary row each ([`sweep`]). No physics
 //! lives here.

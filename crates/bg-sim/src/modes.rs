@@ -1,5 +1,5 @@
 //! `bg-sim modes`: the model's time scales. Linearise at the initial state or at time T of a
-//! run, list every eigenvalue ([`bondgraph::modes`]) with the states that take part in it,
+//! run, list every eigenvalue ([`bondgraph::modes()`]) with the states that take part in it,
 //! and say what they mean for the choice of solver. No physics lives here.
 
 use std::fmt::Write as _;

@@ -1,6 +1,6 @@
 //! [`StateEquations`]: the evaluation plan computing dx/dt = f(t, x) from a [`CausalGraph`].
 //!
-//! Every element splits its work into stages ([`Stage`]); a stage writes some variables
+//! Every element splits its work into stages ([`Stage`](crate::Stage)); a stage writes some variables
 //! (efforts, flows, signals) from others. The stages are ordered topologically over their
 //! data dependencies (petgraph's `toposort`); a cycle is an algebraic loop, reported with the
 //! elements and bonds on it. Evaluating the plan fills every effort, flow and signal; then

@@ -49,7 +49,7 @@
 //! time constant with the participation of each state ([`modes`](mod@modes) module).
 //!
 //! ## Simulation
-//! [`simulate`] integrates with every [`Method`] behind one solver interface — our Radau IIA
+//! [`simulate()`] integrates with every [`Method`] behind one solver interface — our Radau IIA
 //! (order 5, the default) and diffsol's BDF, ESDIRK34, TR-BDF2, Tsit45 — with the exact
 //! Jacobian ([`StateEquations::jacobian`]), output times, scheduled [`Event`]s, limits and
 //! [`Statistics`], and keeps the rows computed when it fails. [`radau`] is the standalone

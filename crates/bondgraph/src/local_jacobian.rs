@@ -156,10 +156,10 @@ impl LocalShape {
 
 /// The partial derivatives of one stage of an element (or of its state derivatives) with
 /// respect to the element's local variables: a dense row-major block the element fills in
-/// [`Element::stage_partials`](crate::Element::stage_partials) and
-/// [`Element::derivative_partials`](crate::Element::derivative_partials).
+/// [`Element::stage_partials`] and
+/// [`Element::derivative_partials`].
 ///
-/// **Columns** are the element's local variables as it sees them through [`Io`](crate::Io):
+/// **Columns** are the element's local variables as it sees them through [`Io`]:
 /// for each port `p` in order, its effort components `e(p, k)`, then its flow components as
 /// *flow into the element* `f_in(p, k)` (power-in convention, like
 /// [`Io::f_in`](crate::Io::f_in) / [`Io::set_f_in`](crate::Io::set_f_in)); then every

@@ -22,7 +22,7 @@
 //! Ṗu = Σ_k u_k ∂v/∂q_k = (A_x − Ω ẇ, A_y)        A = Σ_{k≤i} u_k δ_k
 //! ```
 //!
-//! ([`LinkMotion`]). Every integral of a product of two such fields is a contraction with
+//! (`LinkMotion`). Every integral of a product of two such fields is a contraction with
 //! the Gram matrices G_A, G_I of the link.
 //!
 //! [`ShapeIntegrals`]: crate::ShapeIntegrals

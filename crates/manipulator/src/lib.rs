@@ -24,7 +24,7 @@
 //! ([`ArmKinematics::mass_matrix`], eq. 42), `E = ∂T/∂q` ([`ArmKinematics::kinetic_forces`],
 //! eq. 44), gravity ([`ArmKinematics::gravity_forces`], eqs. 45–48), the accelerations, each
 //! a contraction of the shape integrals, O(modes²) per link, with `_into` forms that do not
-//! allocate; the stiffness ([`PlanarArm::stiffness_matrix`], eq. 51). [`reference`] keeps
+//! allocate; the stiffness ([`PlanarArm::stiffness_matrix`], eq. 51). [`reference`](mod@reference) keeps
 //! the per-station quadrature sums as the tests' reference.
 //!
 //! ## Actuators and lumped masses (sections 3.3, 4.2)

@@ -4,7 +4,7 @@
 use thiserror::Error;
 
 /// Why the integrator stopped. Each variant carries the time reached; the state there is
-/// still readable with [`Radau5::y`].
+/// still readable with [`Radau5::y`](crate::radau::Radau5::y).
 #[derive(Clone, Debug, Error, PartialEq)]
 #[non_exhaustive]
 pub enum RadauError {
