@@ -1,0 +1,209 @@
+//! The interface every integration method sits behind ([`Stepper`]), diffsol's solvers as
+//! steppers, and the one loop that drives any of them through a segment ([`drive`]).
+
+use std::cell::RefCell;
+
+use diffsol::{OdeEquations, OdeSolverMethod, OdeSolverStopReason};
+
+use super::{culprit, same_time, Bound, Recorder, SegmentError, Statistics};
+use crate::error::SimulationError;
+
+/// How a step ended.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum StepEnd {
+    /// An ordinary accepted step.
+    Internal,
+    /// The step landed on the stop time.
+    StopReached,
+    /// A limit's root function crossed zero at this time inside the step (index of the limit).
+    Root(f64, usize),
+}
+
+/// Work counters of one method instance (they start at zero for each segment).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Work {
+    pub(super) steps: usize,
+    pub(super) error_test_failures: usize,
+    pub(super) newton_iterations: usize,
+    pub(super) newton_failures: usize,
+    pub(super) lu: usize,
+}
+
+/// What the run loop needs of an integration method: one accepted step at a time, its state,
+/// dense output inside the last step, and its work. Every method sits behind it, so events,
+/// limits, output rows, NaN checks and partial results work alike for each.
+pub(super) trait Stepper {
+    /// Set the segment's end: steps land on it exactly.
+    fn set_stop_time(&mut self, t_stop: f64) -> Result<(), String>;
+    /// Take one accepted step (never past the segment's stop time).
+    fn step(&mut self) -> Result<StepEnd, String>;
+    /// Current time and step size.
+    fn t_h(&self) -> (f64, f64);
+    /// Current state.
+    fn y(&self) -> Vec<f64>;
+    /// The state at `t` inside the last step.
+    fn interpolate(&self, t: f64) -> Result<Vec<f64>, String>;
+    /// Work so far.
+    fn work(&self) -> Work;
+}
+
+/// A diffsol solver as a [`Stepper`].
+pub(super) struct Diffsol<S, Eqn>(S, std::marker::PhantomData<Eqn>);
+
+impl<S, Eqn> Diffsol<S, Eqn> {
+    pub(super) fn new(s: S) -> Self {
+        Self(s, std::marker::PhantomData)
+    }
+}
+
+impl<'a, Eqn, S> Stepper for Diffsol<S, Eqn>
+where
+    Eqn: OdeEquations<T = f64, V = diffsol::NalgebraVec<f64>> + 'a,
+    S: OdeSolverMethod<'a, Eqn>,
+{
+    fn set_stop_time(&mut self, t_stop: f64) -> Result<(), String> {
+        self.0.set_stop_time(t_stop).map_err(|e| e.to_string())
+    }
+    fn step(&mut self) -> Result<StepEnd, String> {
+        match self.0.step() {
+            Ok(OdeSolverStopReason::InternalTimestep) => Ok(StepEnd::Internal),
+            Ok(OdeSolverStopReason::TstopReached) => Ok(StepEnd::StopReached),
+            Ok(OdeSolverStopReason::RootFound(t, i)) => Ok(StepEnd::Root(t, i)),
+            Err(e) => Err(e.to_string()),
+        }
+    }
+    fn t_h(&self) -> (f64, f64) {
+        let st = self.0.state();
+        (st.t, st.h)
+    }
+    fn y(&self) -> Vec<f64> {
+        self.0.state().y.batch_as_slice(0).to_vec()
+    }
+    fn interpolate(&self, t: f64) -> Result<Vec<f64>, String> {
+        self.0
+            .interpolate(t)
+            .map(|y| y.batch_as_slice(0).to_vec())
+            .map_err(|e| e.to_string())
+    }
+    fn work(&self) -> Work {
+        let st = self.0.get_statistics();
+        Work {
+            steps: st.number_of_steps,
+            error_test_failures: st.number_of_error_test_failures,
+            newton_iterations: st.number_of_nonlinear_solver_iterations,
+            newton_failures: st.number_of_nonlinear_solver_fails,
+            lu: st.number_of_linear_solver_setups,
+        }
+    }
+}
+
+/// Step `s` to `t_stop`, recording the output rows, watching the states, and stopping at a
+/// non-finite state, a limit, a stalled step size or `max_steps`.
+pub(super) fn drive(
+    s: &mut dyn Stepper,
+    rec: &mut Recorder<'_>,
+    t_stop: f64,
+    max_steps: usize,
+    limits: &[Bound],
+    bad: &RefCell<Option<(f64, Vec<f64>)>>,
+    stats: &mut Statistics,
+) -> Result<Vec<f64>, SegmentError> {
+    let eqs = rec.eqs;
+    let finish = |s: &dyn Stepper, stats: &mut Statistics| {
+        let w = s.work();
+        stats.steps += w.steps;
+        stats.error_test_failures += w.error_test_failures;
+        stats.newton_iterations += w.newton_iterations;
+        stats.newton_failures += w.newton_failures;
+        stats.lu_factorisations += w.lu;
+    };
+    let solver_error = |t: f64, message: String, culprit: String| SimulationError::Solver {
+        t,
+        message,
+        culprit,
+    };
+    loop {
+        let step = s.step();
+        let (t, h) = s.t_h();
+        let x = s.y();
+        let reason = match step {
+            Err(e) => {
+                finish(s, stats);
+                return Err((t, x, solver_error(t, e, culprit(eqs, bad))));
+            }
+            Ok(r) => r,
+        };
+        let stalled = !t.is_finite() || !h.is_finite() || h.abs() < 1e-14 * t.abs().max(1.0);
+        let too_many = s.work().steps + stats.steps >= max_steps;
+        if stalled || too_many {
+            finish(s, stats);
+            let message = if stalled {
+                format!("the step size collapsed to {h:e}")
+            } else {
+                format!("more than {max_steps} steps; hint: the model may be much stiffer than the method (try radau5 or bdf) or max_steps too small")
+            };
+            return Err((t, x, solver_error(t, message, culprit(eqs, bad))));
+        }
+        // The run observes an interruption (`Settings::interrupt`) and a refused row here, in
+        // one place, after every accepted step; the per-step outputs (checks) are handed on too.
+        if let Err(e) = rec.accepted(t, &x) {
+            finish(s, stats);
+            return Err((t, x, e));
+        }
+        if let Some(i) = x.iter().position(|v| !v.is_finite()) {
+            finish(s, stats);
+            let info = &eqs.states()[i];
+            let err = SimulationError::NonFinite {
+                t,
+                state: info.name.clone(),
+                element: eqs.graph().node(info.element).name.clone(),
+                value: x[i],
+                culprit: culprit(eqs, bad),
+            };
+            return Err((t, x, err));
+        }
+        // A limit reached inside the step: rows up to the crossing, then stop there.
+        let root = match reason {
+            StepEnd::Root(tr, idx) => Some((tr, idx)),
+            _ => None,
+        };
+        let t_rows = root.map_or(t, |(tr, _)| tr);
+        while let Some(tg) = rec.pending() {
+            if tg > t_rows
+                || same_time(tg, t_stop)
+                || tg > t_stop
+                || (root.is_some() && same_time(tg, t_rows))
+            {
+                break;
+            }
+            if same_time(tg, t) {
+                rec.record(tg, &x);
+            } else {
+                match s.interpolate(tg) {
+                    Ok(y) => rec.record(tg, &y),
+                    Err(e) => {
+                        finish(s, stats);
+                        let message = format!("interpolation at t = {tg}: {e}");
+                        return Err((t, x, solver_error(t, message, String::new())));
+                    }
+                }
+            }
+        }
+        if let Some((tr, idx)) = root {
+            finish(s, stats);
+            let xr = s.interpolate(tr).unwrap_or(x);
+            let err = limits.get(idx).map_or_else(
+                || {
+                    let message = format!("root {idx} found, but no limit has that index");
+                    solver_error(tr, message, String::new())
+                },
+                |b| b.error(tr),
+            );
+            return Err((tr, xr, err));
+        }
+        if reason == StepEnd::StopReached {
+            finish(s, stats);
+            return Ok(x);
+        }
+    }
+}
