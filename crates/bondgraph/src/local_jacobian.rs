@@ -196,10 +196,10 @@ pub struct LocalJacobian<'a> {
     touched: Option<Touched<'a>>,
 }
 
-/// The list of entries a [`LocalJacobian`] has set, and a mark per entry.
+/// The list of entries a [`LocalJacobian`] has set, as (row, column), and a mark per entry.
 #[derive(Debug)]
 pub(crate) struct Touched<'a> {
-    pub(crate) list: &'a mut Vec<usize>,
+    pub(crate) list: &'a mut Vec<(u32, u32)>,
     pub(crate) mark: &'a mut [bool],
 }
 
@@ -233,11 +233,12 @@ impl<'a> LocalJacobian<'a> {
         }
     }
 
-    fn note(&mut self, index: usize) {
+    fn note(&mut self, row: usize, col: usize, index: usize) {
         if let Some(t) = &mut self.touched {
             if !t.mark[index] {
                 t.mark[index] = true;
-                t.list.push(index);
+                // shapes are far below u32::MAX rows or columns (a block is rows × columns)
+                t.list.push((row as u32, col as u32));
             }
         }
     }
@@ -304,14 +305,14 @@ impl<'a> LocalJacobian<'a> {
     pub fn set(&mut self, row: usize, col: usize, v: f64) {
         let i = row * self.shape.n_cols + col;
         self.values[i] = v;
-        self.note(i);
+        self.note(row, col, i);
     }
 
     /// Add `v` to entry (row, col).
     pub fn add(&mut self, row: usize, col: usize, v: f64) {
         let i = row * self.shape.n_cols + col;
         self.values[i] += v;
-        self.note(i);
+        self.note(row, col, i);
     }
 
     /// Entry (row, col).
@@ -324,7 +325,8 @@ impl<'a> LocalJacobian<'a> {
     pub fn zero(&mut self) {
         match &mut self.touched {
             Some(t) => {
-                for &i in t.list.iter() {
+                for &(r, c) in t.list.iter() {
+                    let i = r as usize * self.shape.n_cols + c as usize;
                     self.values[i] = 0.0;
                     t.mark[i] = false;
                 }

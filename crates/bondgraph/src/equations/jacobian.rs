@@ -77,7 +77,7 @@ pub(super) struct JacobianWork {
     /// A local Jacobian block (all zero between blocks), the entries an element set in it and
     /// their marks.
     local: Vec<f64>,
-    touched: Vec<usize>,
+    touched: Vec<(u32, u32)>,
     mark: Vec<bool>,
     /// Row values at the evaluation point, and perturbed.
     base: Vec<f64>,
@@ -475,10 +475,11 @@ impl Block<'_> {
         let gives = self.partials(id, target, plan);
         let nc = plan.shape.n_cols();
         for k in 0..self.w.touched.len() {
-            let i = self.w.touched[k];
+            let (r, c) = self.w.touched[k];
+            let (r, c) = (r as usize, c as usize);
+            let i = r * nc + c;
             let v = std::mem::take(&mut self.w.local[i]);
             self.w.mark[i] = false;
-            let (r, c) = (i / nc, i % nc);
             if gives && v != 0.0 {
                 self.add(r, v * plan.rows[r].1, plan.col_dep[c]);
             }
