@@ -69,3 +69,70 @@ fn the_documented_range_of_modes_is_the_enforced_one() {
     let e = bg_tests::load("knuckle_boom", &["parameters.modes1=65"]).unwrap_err();
     assert!(e.to_string().contains("0..=64"), "{e}");
 }
+
+/// The project stands on its own: no source, model, test or document cites a file outside the
+/// repository (the scene's conventions are in docs/knuckle-boom.md, in our own words).
+#[test]
+fn nothing_cites_a_file_outside_the_repository() {
+    fn walk(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
+        for e in std::fs::read_dir(dir).unwrap().filter_map(Result::ok) {
+            let p = e.path();
+            let name = e.file_name().to_string_lossy().into_owned();
+            if p.is_dir() {
+                if !matches!(name.as_str(), "target" | ".git" | "venv" | "__pycache__") {
+                    walk(&p, out);
+                }
+            } else if ["rs", "md", "toml", "py", "pyi", "sh", "txt"]
+                .iter()
+                .any(|x| name.ends_with(&format!(".{x}")))
+                || name == "run"
+            {
+                out.push(p);
+            }
+        }
+    }
+    let root = root();
+    let mut files = Vec::new();
+    for top in [
+        "README.md",
+        "ARCHITECTURE.md",
+        ".ci",
+        "crates",
+        "docs",
+        "models",
+        "tests",
+        "scripts",
+    ] {
+        let p = root.join(top);
+        if p.is_dir() {
+            walk(&p, &mut files);
+        } else if p.exists() {
+            files.push(p);
+        }
+    }
+    assert!(files.len() > 50, "{} files", files.len());
+    // spelled in pieces, so that this file does not match itself
+    let outside = [
+        ["shared", "/design"].concat(),
+        ["shared", "/papers"].concat(),
+        ["shared", "/guides"].concat(),
+        ["../", "shared"].concat(),
+        ["design", " page"].concat(),
+    ];
+    let mut found = Vec::new();
+    for f in &files {
+        let Ok(text) = std::fs::read_to_string(f) else {
+            continue;
+        };
+        for (i, line) in text.lines().enumerate() {
+            if outside.iter().any(|o| line.contains(o.as_str())) {
+                found.push(format!("{}:{}: {line}", f.display(), i + 1));
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "references outside the repository:\n{}",
+        found.join("\n")
+    );
+}

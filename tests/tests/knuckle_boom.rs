@@ -1,5 +1,5 @@
-//! The knuckle boom crane, `models/knuckle_boom.toml`, against the design page
-//! (`shared/design/knuckle-boom.md`) and against an independent rigid-body computation:
+//! The knuckle boom crane, `models/knuckle_boom.toml`, against its conventions
+//! (`docs/knuckle-boom.md`) and against an independent rigid-body computation:
 //!
 //! * the initial pressures the file's steady start solves (`[initial.steady]`, Newton on the
 //!   model's own equations) are the rigid static balance (`τ_b F + G = 0`, first two rows)
@@ -10,8 +10,8 @@
 //!   links released undeformed it is not;
 //! * a 0-mode run matches [`RigidCrane`]: Lagrange's equations of two rigid booms, the
 //!   pendulum and the point masses, with the cylinders, valves, spool lags and controllers of
-//!   the design page, integrated by classical RK4 — pointwise (accelerations from the run's
-//!   states and pressures) and over the whole 20 s run; its final pose is the design page's
+//!   the docs/knuckle-boom.md, integrated by classical RK4 — pointwise (accelerations from the run's
+//!   states and pressures) and over the whole 20 s run; its final pose is the scene's
 //!   rigid sanity figures up to the controller's remaining length error;
 //! * the energy bookkeeping of the flexible scene closes;
 //! * a run at the file's settings agrees with one at rtol 1e-9 on every column.
@@ -135,7 +135,7 @@ fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
 // ---------------------------------------------------------------------------------------
 // An independent model of the rigid crane
 
-/// The rigid crane written out by hand from the design page. Coordinates are the absolute
+/// The rigid crane written out by hand from docs/knuckle-boom.md. Coordinates are the absolute
 /// chord angles θ = (φ1, φ2, φ3) (φ1 = q1, φ2 = q1 + q2, φ3 = q1 + q2 + q3). Every mass is
 /// a point or a uniform rod on body b, at distance s from its joint: its position is
 /// `Σ_j a_j e(θ_j)` with a_j = L_j for j < b and a_b = s. So
@@ -201,7 +201,7 @@ fn solve3(mut m: [[f64; 3]; 3], mut b: [f64; 3]) -> [f64; 3] {
     x
 }
 
-/// regRoot of the design page: Δp/(Δp² + p_tr²)^¼.
+/// regRoot of docs/knuckle-boom.md: Δp/(Δp² + p_tr²)^¼.
 fn reg_root(dp: f64, p_tr: f64) -> f64 {
     dp / (dp * dp + p_tr * p_tr).powf(0.25)
 }
@@ -452,7 +452,7 @@ fn rigid_model(rtol: f64) -> Model {
 // ---------------------------------------------------------------------------------------
 // The tests
 
-/// The hold forces the design page derives by hand (the formulas `models/knuckle_boom.toml`
+/// The hold forces docs/knuckle-boom.md derived by hand (the formulas `models/knuckle_boom.toml`
 /// carried before its steady start): g·Σ / (∂l/∂q), Σ the first moments of the masses
 /// outboard of each joint.
 fn hand_derived_hold_forces(p: &IndexMap<String, f64>) -> (f64, f64) {
@@ -491,7 +491,7 @@ fn state(model: &Model, name: &str) -> f64 {
 }
 
 /// The file's steady start solves the initial pressures on the model's own equations; they
-/// equal the design page's hand-derived hold pressures to 1e-6 relative (measured: 5e-13),
+/// equal the scene's hand-derived hold pressures to 1e-6 relative (measured: 5e-13),
 /// and the forces they give are the rigid static balance computed by the hand-written model
 /// and by the manipulator crate's own τ_b and G: about +207 kN and −80.6 kN.
 #[test]
@@ -517,7 +517,7 @@ fn hold_forces_are_the_rigid_static_balance() {
         "the less loaded chambers stay at p_pre"
     );
     let (h1, h2) = hand_derived_hold_forces(&p);
-    // the design page's rule: the less loaded chamber at p_pre
+    // the scene's rule: the less loaded chamber at p_pre
     let (want_p1, want_r2) = ((h1 + a_r * pre) / a_p, (a_p * pre - h2) / a_r);
     let (e1, e2) = ((pp1 / want_p1 - 1.0).abs(), (pr2 / want_r2 - 1.0).abs());
     eprintln!("solved P_p1 = {pp1:.6} Pa (hand-derived {want_p1:.6}, rel. {e1:.1e}), P_r2 = {pr2:.6} Pa ({want_r2:.6}, rel. {e2:.1e})");
@@ -617,7 +617,7 @@ fn initial_pressures_make_the_rigid_crane_a_rest_state() {
 /// A 0-mode run (lumped masses rigid) against the hand-written rigid crane: the run's
 /// accelerations at every row equal the Lagrange model's for the run's own state and
 /// chamber pressures; integrated on its own by RK4, the Lagrange model follows the run for
-/// 20 s; and the run ends at the design page's rigid sanity pose.
+/// 20 s; and the run ends at the scene's rigid sanity pose.
 #[test]
 fn rigid_crane_matches_an_independent_lagrange_model() {
     let mut m = rigid_model(1e-9);
@@ -870,7 +870,7 @@ fn scene_switches_load_and_run() {
     }
 }
 
-/// The result columns of the design page, named exactly as there, every 0.01 s.
+/// The result columns of docs/knuckle-boom.md, named exactly as there, every 0.01 s.
 #[test]
 fn the_run_writes_the_design_page_columns() {
     let m = variant(|_| {});
@@ -889,7 +889,7 @@ fn the_run_writes_the_design_page_columns() {
     assert_eq!(events.len(), 1);
     assert!((events[0].t - m.parameters["t_switch"]).abs() < 1e-15);
     assert!((m.settings.dt_out - 0.01).abs() < 1e-15);
-    // the design page's areas and the retracted geometry
+    // the scene's areas and the retracted geometry
     let p = &m.parameters;
     assert!((p["A_p"] - 0.045_238_9).abs() < 1e-7);
     assert!((p["A_r"] - 0.042_411_5).abs() < 1e-7);

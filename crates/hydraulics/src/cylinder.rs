@@ -17,7 +17,7 @@
 //! expression). Without a valve (`valve: None`) the lines are driven through the exposed
 //! ports `A` and `B`.
 //!
-//! Chamber pressures start from [`InitialPressures`]; [`hold_pressures`] is the design page's
+//! Chamber pressures start from [`InitialPressures`]; [`hold_pressures`] is the scene's
 //! static initialisation rule.
 
 use bg_model::Composite;
@@ -26,7 +26,7 @@ use bondgraph::{BondGraph, Error, GraphError, OneJunction, Param, ParamError, Ze
 use crate::{Chamber, EndStop, Leakage, Piston, Side, Valve};
 
 /// The chamber pressures (P_p, P_r) that hold force `force` (N, positive pushing the pins
-/// apart) with the less loaded chamber at `p_pre` (design page, "Initial pressures"):
+/// apart) with the less loaded chamber at `p_pre` (docs/knuckle-boom.md, "Initial state"):
 /// for F ≥ 0, P_r = p_pre and P_p = (F + A_r·p_pre)/A_p; for F < 0, P_p = p_pre and
 /// P_r = (A_p·p_pre − F)/A_r. Then A_p·P_p − A_r·P_r = F exactly (up to rounding).
 #[must_use]
@@ -342,7 +342,7 @@ mod tests {
                 assert_eq!(pp, 1e6);
             }
         }
-        // the design page's sanity figure: 512 kN with the rod side at tank → P_p ≈ 11.3 MPa
+        // the scene's sanity figure: 512 kN with the rod side at tank → P_p ≈ 11.3 MPa
         let (pp, _) = hold_pressures(512e3, a_p, a_r, 0.0);
         assert!((pp - 11.32e6).abs() < 0.01e6, "{pp}");
     }

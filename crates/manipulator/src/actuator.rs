@@ -1,4 +1,4 @@
-//! Linear actuators between two pins (eqs. 52–69, design page): length l(q) from the deformed
+//! Linear actuators between two pins (eqs. 52–69, docs/knuckle-boom.md): length l(q) from the deformed
 //! pin positions, and the matrix `τ_b = ∂l/∂q` of the MTF to the cylinders (eq. 66).
 //!
 //! An actuator acts along the line between its pins `a` (barrel end) and `b` (rod end); its
@@ -7,7 +7,7 @@
 //! `w = [R_0^i f; 0]` of the pin force at the pin in the pin link's frame — which is
 //! `(∂l/∂q)ᵀ F` exactly, the MTF law `τ = τ_b F`, `l̇ = τ_bᵀ u` (eqs. 66, 69). The paper's
 //! sine-rule expressions (eqs. 52–63) approximate the same exact distances to second order in
-//! the deflection; here the distances are exact (design page).
+//! the deflection; here the distances are exact (docs/knuckle-boom.md).
 
 use nalgebra::{DMatrix, DVector, Vector2};
 

@@ -4,7 +4,7 @@
 //! # Generalized coordinates (eq. 32)
 //! `q = [q_1 … q_{n_q}, q^{b1} …, q^{b n_q} …]`: first one chord-to-chord joint angle per
 //! link, then the modal coordinates of each link in link order (a rigid link has none). The
-//! knuckle boom of the design page has `q = [q1, q2, q3, qb1_1..3, qb2_1..3]`.
+//! knuckle boom (docs/knuckle-boom.md) has `q = [q1, q2, q3, qb1_1..3, qb2_1..3]`.
 //!
 //! # Frames
 //! Frame 0 is inertial with gravity along −y₀. Frame i sits at joint i: at the origin of
@@ -137,7 +137,7 @@ impl PlanarArm {
         self.links.iter().map(Link::mass).sum()
     }
 
-    /// A line of names for q: `q1.., qb1_1..` (1-based, as in the design page).
+    /// A line of names for q: `q1.., qb1_1..` (1-based, as in docs/knuckle-boom.md).
     #[must_use]
     pub fn coordinate_names(&self) -> Vec<String> {
         let mut names: Vec<String> = (1..=self.links.len()).map(|i| format!("q{i}")).collect();

@@ -1,4 +1,4 @@
-//! Revolute joints of a planar serial chain, with chord-to-chord joint angles (design page).
+//! Revolute joints of a planar serial chain, with chord-to-chord joint angles (docs/knuckle-boom.md).
 //!
 //! Joint 1 sits at the origin of frame 0; joint i+1 sits at the end of link i's chord, so
 //! bending of link i never moves link i+1. Joint i turns about z_i: its twist is `u_i L_{i/i}`

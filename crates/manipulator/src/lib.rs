@@ -2,7 +2,7 @@
 //!
 //! Sections 2–5 of Cibicik, Pedersen & Egeland, *Dynamics of luffing motion of a flexible
 //! knuckle boom crane actuated by hydraulic cylinders* (Mech. Mach. Theory 2019), with the
-//! conventions of `shared/design/knuckle-boom.md`; `docs/manipulator.md` gives the
+//! conventions of `docs/knuckle-boom.md`; `docs/manipulator.md` gives the
 //! formulation with the paper's equation numbers.
 //!
 //! ## Screw algebra (section 2)

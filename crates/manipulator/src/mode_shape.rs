@@ -1,7 +1,7 @@
 //! Assumed modes `ψ_k(x)` of a flexible link (section 3.1): the transverse deflection of the
 //! link at distance x along its chord is `w(x) = Σ_k ψ_k(x) q_k^b`.
 //!
-//! Joint angles are chord-to-chord (design page), so every mode must vanish at both ends of
+//! Joint angles are chord-to-chord (docs/knuckle-boom.md), so every mode must vanish at both ends of
 //! the chord, `ψ(0) = ψ(L) = 0`: the deflection of a link then never moves the next joint, and
 //! the projection matrix of a link holds only its own modes (eq. 38). [`Link`] checks this
 //! when a mode is attached.

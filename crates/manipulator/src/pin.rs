@@ -1,4 +1,4 @@
-//! Pins: attachment points of actuators and lumped masses (design page, Fig. 3).
+//! Pins: attachment points of actuators and lumped masses (docs/knuckle-boom.md; the paper's Fig. 3).
 //!
 //! A pin is fixed in frame 0 (the crane base) or sits on the *deformed* axis of a link at
 //! distance x along its chord, i.e. at `(x, w(x))` in the link's frame. Resolved on an arm

@@ -8,7 +8,7 @@
 //! S_{i_e/i_e}^i = [ L_z θ_k(x) + N_y ψ_k(x) ]_k                              (eq. 36)
 //! ```
 //!
-//! The reference point is the *deformed* position `(x, w(x))` (design page): `p_{i_e,j}^j`
+//! The reference point is the *deformed* position `(x, w(x))` (docs/knuckle-boom.md): `p_{i_e,j}^j`
 //! in `V` runs from there to joint j. Expressed in frame 0 instead (`R̄_i^0 P`, eq. 73), the
 //! rows `N_c = [0 I₂ 0]` (eq. 72) of the projection are the velocity Jacobian of the point,
 //! which gives `J_c` (eq. 71) and the pin velocities of the actuators.

@@ -1,4 +1,4 @@
-//! Reaction forces in the passive joints (section 5, eqs. 84–98), in the design page's
+//! Reaction forces in the passive joints (section 5, eqs. 84–98), in the scene's
 //! convention, contracted from the links' shape integrals.
 //!
 //! The method of auxiliary generalized speeds gives joint j a fictitious translation along

@@ -1,4 +1,4 @@
-//! Linear actuators and lumped masses: the design page's geometry and static figures,
+//! Linear actuators and lumped masses: the scene's geometry and static figures,
 //! τ_b = ∂l/∂q and J_c against finite differences, and power conservation of both MTFs.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 

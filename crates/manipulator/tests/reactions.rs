@@ -1,4 +1,4 @@
-//! Reaction forces in the passive joints (section 5), in the design page's convention:
+//! Reaction forces in the passive joints (section 5), in the scene's convention (docs/knuckle-boom.md):
 //! ρ_{2j−1}, ρ_{2j} is the force that the inboard body exerts on link j through joint j, in
 //! the axes of frame j.
 #![allow(clippy::unwrap_used, clippy::expect_used)]

@@ -1,6 +1,6 @@
 //! The MTF from the generalized coordinates to the linear actuators (eq. 66):
 //! `e₁ = τ_b e₂`, `f_in₂ = −τ_bᵀ f_in₁`, with `τ_b = ∂l/∂q` (n × n_act) from the deformed
-//! pin positions (eqs. 52–69, exact distances per the design page).
+//! pin positions (eqs. 52–69, exact distances, docs/knuckle-boom.md).
 //!
 //! Drawn with port 1 from the MTF into the arm's 1-junction and the cylinder bonds into
 //! port 2, e₂ is the cylinder forces F_c (positive pushing the pins apart), the MTF delivers

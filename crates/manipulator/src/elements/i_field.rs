@@ -20,7 +20,7 @@
 //! the deflection at mid-chord. Its states are `p[k]` and `q[k]`; the vector `<name>.q` is
 //! what the other fields read. Each coordinate is also published by name, with its speed:
 //! `q1`, `u1`, … for the joints and `qb{i}_{k}`, `ub{i}_{k}` for the modes of link i
-//! (1-based, the design page's names); `qb{i}_{k}`/`ub{i}_{k}` exist for k = 1, 2, 3 even
+//! (1-based, the scene's column names); `qb{i}_{k}`/`ub{i}_{k}` exist for k = 1, 2, 3 even
 //! when link i has fewer modes (a mode that is not modelled has zero amplitude), so result
 //! columns survive a change of the number of modes.
 //!

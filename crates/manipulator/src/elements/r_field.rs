@@ -1,6 +1,6 @@
 //! The manipulator R-field: generalized damping forces `e = D f_in`, D = diag(d) ≥ 0.
 //!
-//! The design page's damping `D = diag(0, 0, r_p, r_e …)` acts on the joint speed of the
+//! The scene's damping `D = diag(0, 0, r_p, r_e …)` acts on the joint speed of the
 //! pendulum and on the modal speeds. Entries may be zero (resistance causality only, which
 //! the arm's 1-junction gives it), so a scheduled event can switch them by rebuilding the
 //! element with other values: the shape, causality and stages stay the same.

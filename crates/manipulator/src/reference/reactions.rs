@@ -1,4 +1,4 @@
-//! Reaction forces in the passive joints (section 5, eqs. 84–98), in the design page's
+//! Reaction forces in the passive joints (section 5, eqs. 84–98), in the scene's
 //! convention.
 //!
 //! The method of auxiliary generalized speeds: give joint j a fictitious translation along

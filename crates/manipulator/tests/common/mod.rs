@@ -1,4 +1,4 @@
-//! The knuckle boom of the design page, shared by the integration tests.
+//! The knuckle boom (docs/knuckle-boom.md), shared by the integration tests.
 #![allow(dead_code, clippy::unwrap_used, clippy::expect_used)]
 
 use std::f64::consts::PI;
@@ -10,7 +10,7 @@ pub const M3: f64 = 5000.0;
 pub const M_P: f64 = 235.0;
 pub const M_B: f64 = 713.0;
 
-/// Link 1 and 2 of the design page with `modes` sine modes each, and the payload pendulum.
+/// Link 1 and 2 of docs/knuckle-boom.md with `modes` sine modes each, and the payload pendulum.
 pub fn crane_links(modes: u32) -> Vec<Link> {
     let beam = |l: f64| {
         Link::beam(l, 210e9, 7850.0, 0.0264, 5.89e-4)
