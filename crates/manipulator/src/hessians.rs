@@ -62,7 +62,7 @@ impl ArmKinematics<'_> {
             let d = g.deflection_moments(qb, ub);
             let f = self.link_motion(i, u);
             let (mass, s1, om) = (g.mass(), g.first_moment(), f.omega);
-            let p = Vector2::new(mass * f.v.x - om * d.w, mass * f.v.y + om * s1 + d.w_dot);
+            let p = f.momentum(g, &d);
             for l in 0..=i {
                 let dl = self.delta(i, l, u);
                 let cl = self.pose.chord_offset(i, l);

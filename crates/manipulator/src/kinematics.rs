@@ -30,6 +30,7 @@
 use nalgebra::Vector2;
 
 use crate::arm::{z_cross, PlanarArm, Pose};
+use crate::shape_integrals::{DeflectionMoments, ShapeIntegrals};
 
 /// The arm at configuration q.
 #[derive(Clone, Debug)]
@@ -43,6 +44,18 @@ pub(crate) struct LinkMotion {
     pub(crate) omega: f64,
     pub(crate) v: Vector2<f64>,
     pub(crate) a: Vector2<f64>,
+}
+
+impl LinkMotion {
+    /// The link's linear momentum in its own frame, P = ∫ρA v dx
+    /// = (m·V_x − Ω·∫ρA w, m·V_y + Ω·∫ρA x + ∫ρA ẇ), from its shape integrals `g` and the
+    /// deflection moments `d` at the current modal coordinates and speeds.
+    pub(crate) fn momentum(&self, g: &ShapeIntegrals, d: &DeflectionMoments) -> Vector2<f64> {
+        Vector2::new(
+            g.mass() * self.v.x - self.omega * d.w,
+            g.mass() * self.v.y + self.omega * g.first_moment() + d.w_dot,
+        )
+    }
 }
 
 impl PlanarArm {

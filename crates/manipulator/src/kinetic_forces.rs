@@ -57,7 +57,7 @@ impl ArmKinematics<'_> {
             let d = g.deflection_moments(qb, ub);
             let f = self.link_motion(i, u);
             let (mass, s1, om) = (g.mass(), g.first_moment(), f.omega);
-            let p = Vector2::new(mass * f.v.x - om * d.w, mass * f.v.y + om * s1 + d.w_dot);
+            let p = f.momentum(g, &d);
             let s_total = Vector2::new(f.v.y, -f.v.x); // Σ_{j≤i} u_j c_j
             let (mut u_before, mut s_before) = (0.0, Vector2::zeros());
             for (k, uk) in u.iter().enumerate().take(i + 1) {

@@ -114,7 +114,7 @@ impl ArmKinematics<'_> {
             let w_ddot: f64 = (0..qb.len()).map(|k| g.mode_mass(k) * udb[k]).sum();
             let (f, fd) = (self.link_motion(i, u), self.link_motion(i, u_dot));
             let (mass, s1, om) = (g.mass(), g.first_moment(), f.omega);
-            let p = Vector2::new(mass * f.v.x - om * d.w, mass * f.v.y + om * s1 + d.w_dot);
+            let p = f.momentum(g, &d);
             let ma = Vector2::new(
                 mass * fd.v.x - fd.omega * d.w,
                 mass * fd.v.y + fd.omega * s1 + w_ddot,
