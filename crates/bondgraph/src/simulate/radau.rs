@@ -42,7 +42,7 @@ struct RadauStepper<'e> {
     radau: Radau5,
     sys: RadauEquations<'e>,
     t_stop: f64,
-    limits: Vec<Bound>,
+    limits: &'e [Bound],
 }
 
 impl RadauStepper<'_> {
@@ -175,9 +175,8 @@ pub(super) fn run_radau(
         radau,
         sys,
         t_stop,
-        limits,
+        limits: &limits,
     };
-    let limits = stepper.limits.clone();
     let result = drive(
         &mut stepper,
         rec,
