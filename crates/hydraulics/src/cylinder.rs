@@ -23,7 +23,7 @@
 use bg_model::Composite;
 use bondgraph::{BondGraph, Error, GraphError, OneJunction, Param, ParamError, ZeroJunction};
 
-use crate::{Chamber, EndStop, Leakage, Piston, Side, Valve};
+use crate::{Chamber, EndStop, FluidOptions, Leakage, Piston, Side, Valve};
 
 /// The chamber pressures (P_p, P_r) that hold force `force` (N, positive pushing the pins
 /// apart) with the less loaded chamber at `p_pre` (docs/knuckle-boom.md, "Initial state"):
@@ -116,6 +116,8 @@ pub struct Cylinder {
     pub r_ext: Option<f64>,
     /// End stop, if any; without one, leaving [0, s_max] stops the run with an error.
     pub end_stop: Option<EndStopSpec>,
+    /// Entrained air and cavitation in both chambers (default: off, constant β).
+    pub fluid: FluidOptions,
 }
 
 /// Where the exposed ports of a cylinder added with [`Cylinder::add_to`] are: element names.
@@ -152,6 +154,7 @@ impl Cylinder {
             r_int: None,
             r_ext: None,
             end_stop: None,
+            fluid: FluidOptions::default(),
         }
     }
 
@@ -231,10 +234,11 @@ impl Cylinder {
         let chamber = |side, area, l, p0| -> Result<Chamber, ParamError> {
             let c = Chamber::cylinder(side, area, l, self.beta, stroke(), p0)?
                 .with_tank_pressure(self.p_t)?;
-            match self.v_min {
-                Some(v) => c.with_v_min(v),
-                None => Ok(c),
-            }
+            let c = match self.v_min {
+                Some(v) => c.with_v_min(v)?,
+                None => c,
+            };
+            c.with_fluid(self.fluid)
         };
         let mut c = Composite::default();
         c.element("jp", ZeroJunction)

@@ -49,6 +49,7 @@
 pub mod chamber;
 pub mod cylinder;
 pub mod end_stop;
+pub mod fluid;
 pub mod kinds;
 pub mod leakage;
 pub mod orifice;
@@ -60,6 +61,7 @@ pub use cylinder::{
     expand, hold_pressures, Cylinder, CylinderPorts, EndStopSpec, InitialPressures, ValveSpec,
 };
 pub use end_stop::EndStop;
+pub use fluid::{Fluid, FluidOptions};
 pub use leakage::Leakage;
 pub use orifice::{alpha, reg_root, reg_root_derivative, Orifice};
 pub use piston::Piston;
