@@ -46,6 +46,7 @@
 //!
 //! [`BondGraph`]: bondgraph::BondGraph
 
+pub mod accumulator;
 pub mod chamber;
 pub mod cylinder;
 pub mod end_stop;
@@ -56,6 +57,7 @@ pub mod orifice;
 pub mod piston;
 pub mod valve;
 
+pub use accumulator::Accumulator;
 pub use chamber::{Chamber, Side};
 pub use cylinder::{
     expand, hold_pressures, Cylinder, CylinderPorts, EndStopSpec, InitialPressures, ValveSpec,
