@@ -55,6 +55,7 @@ pub mod kinds;
 pub mod leakage;
 pub mod orifice;
 pub mod piston;
+pub mod tank;
 pub mod valve;
 
 pub use accumulator::Accumulator;
@@ -67,6 +68,7 @@ pub use fluid::{Fluid, FluidOptions};
 pub use leakage::Leakage;
 pub use orifice::{alpha, reg_root, reg_root_derivative, Orifice};
 pub use piston::Piston;
+pub use tank::Tank;
 pub use valve::Valve;
 
 /// Register every `hydraulics.*` element kind (and the `hydraulics.cylinder` composite).
