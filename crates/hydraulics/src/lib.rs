@@ -53,6 +53,7 @@ pub mod end_stop;
 pub mod fluid;
 pub mod kinds;
 pub mod leakage;
+pub mod line;
 pub mod orifice;
 pub mod piston;
 pub mod tank;
@@ -66,6 +67,7 @@ pub use cylinder::{
 pub use end_stop::EndStop;
 pub use fluid::{Fluid, FluidOptions};
 pub use leakage::Leakage;
+pub use line::{Line, LineSpec, Wall};
 pub use orifice::{alpha, reg_root, reg_root_derivative, Orifice};
 pub use piston::Piston;
 pub use tank::Tank;
