@@ -8,7 +8,7 @@
 //!
 //! Each to 1e-9 of the terms' scale (1e-6 for the accumulator's energy, a difference
 //! quotient).
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)] // copied values compare exactly
 
 use bg_hydraulics::{Accumulator, Chamber, FluidOptions, Leakage, Line, LineSpec, Tank, Wall};
 use bondgraph::*;

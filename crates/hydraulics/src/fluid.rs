@@ -241,6 +241,7 @@ impl Fluid {
 }
 
 #[cfg(test)]
+#[allow(clippy::float_cmp)] // exact zeros are meant exactly
 mod tests {
     use super::*;
 

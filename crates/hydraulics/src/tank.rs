@@ -84,6 +84,7 @@ impl Element for Tank {
 }
 
 #[cfg(test)]
+#[allow(clippy::float_cmp)] // a constant and a copied parameter are meant exactly
 mod tests {
     use super::*;
     use crate::Chamber;
