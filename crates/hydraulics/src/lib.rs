@@ -32,6 +32,13 @@
 //! - [`Orifice`] (`hydraulics.orifice`) and [`Valve`] (`hydraulics.valve`): eqs. 29–31 with
 //!   the square root regularised by [`reg_root`].
 //!
+//! - [`Accumulator`] (`hydraulics.accumulator`): gas-charged C, oil-volume state, polytropic
+//!   gas law, stiff oil below the precharge.
+//! - [`Line`] (`hydraulics.line`): N lumped C–R–I segments of a pipe or hose
+//!   (Hagen–Poiseuille, inertance, wall compliance).
+//! - [`Tank`] (`hydraulics.tank`): constant pressure, counts the volume it receives.
+//! - [`fluid`]: the chamber's options, entrained air (β_eff(p)) and cavitation.
+//!
 //! The spool's P-controller (eq. 83) and first-order lag are the core's `p_control` and
 //! `lag`; they read the cylinder length `<cylinder>_piston.l`.
 //!
