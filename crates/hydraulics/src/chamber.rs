@@ -317,7 +317,7 @@ impl Element for Chamber {
             state: 0,
             // Undershoots within the solver's tolerance band are not cavitation.
             warn_below: Some(self.p_tank - 1e-6 * self.p_nominal),
-            warning: "cavitation, which the model does not represent (set `cavitation = true` on the chamber to represent it)".into(),
+            warning: "cavitation, which the model does not represent (set `cavitation = true` on the chamber or its cylinder to represent it)".into(),
         }]
     }
 }
