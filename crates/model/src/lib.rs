@@ -45,12 +45,14 @@ pub mod error;
 pub mod expr;
 pub mod load;
 pub mod overrides;
+pub mod plots;
 pub mod registry;
 pub mod scene;
 pub mod steady;
 
 pub use error::{ErrorKind, ModelError};
 pub use load::{inspect, Check, CheckResult, Inspection, Model};
+pub use plots::{Panel, Plot, Series};
 pub use registry::{
     BuildFn, Builder, Composite, CompositeFn, ElementSpec, KindInfo, RawValue, Registry,
 };
