@@ -159,40 +159,7 @@ impl Plot {
         let Some((column, line)) = missing else {
             return Ok(());
         };
-        // the same but for case, else those a misspelling away
-        let mut close: Vec<&str> = columns
-            .iter()
-            .map(String::as_str)
-            .filter(|n| n.eq_ignore_ascii_case(column))
-            .collect();
-        if close.is_empty() {
-            close = columns
-                .iter()
-                .map(String::as_str)
-                .filter(|n| {
-                    crate::registry::similar(column, n) || crate::registry::similar(n, column)
-                })
-                .take(8)
-                .collect();
-        }
-        let hint = if close.is_empty() {
-            let shown: Vec<&str> = columns.iter().map(String::as_str).take(12).collect();
-            let more = columns.len().saturating_sub(shown.len());
-            format!(
-                "the results have the columns {}{}: name one of them, or add the column to [outputs]",
-                shown.join(", "),
-                if more > 0 { format!(" and {more} more") } else { String::new() }
-            )
-        } else {
-            format!(
-                "did you mean {}?",
-                close
-                    .iter()
-                    .map(|c| format!("`{c}`"))
-                    .collect::<Vec<_>>()
-                    .join(" or ")
-            )
-        };
+        let hint = column_hint(column, columns);
         Err(ModelError::new(
             ErrorKind::Plot,
             file,
@@ -204,6 +171,41 @@ impl Plot {
         )
         .at(Some((line, 1)))
         .hint(hint))
+    }
+}
+
+/// What to say of a column that is not among `columns`: the names that differ only in case
+/// (else those a misspelling away), or the columns there are.
+#[must_use]
+pub fn column_hint(column: &str, columns: &[String]) -> String {
+    let mut close: Vec<&str> = columns
+        .iter()
+        .map(String::as_str)
+        .filter(|n| n.eq_ignore_ascii_case(column))
+        .collect();
+    if close.is_empty() {
+        close = columns
+            .iter()
+            .map(String::as_str)
+            .filter(|n| crate::registry::similar(column, n) || crate::registry::similar(n, column))
+            .take(8)
+            .collect();
+    }
+    if close.is_empty() {
+        let shown: Vec<&str> = columns.iter().map(String::as_str).take(12).collect();
+        let more = columns.len().saturating_sub(shown.len());
+        format!(
+            "the results have the columns {}{}: name one of them, or add the column to [outputs]",
+            shown.join(", "),
+            if more > 0 {
+                format!(" and {more} more")
+            } else {
+                String::new()
+            }
+        )
+    } else {
+        let quoted: Vec<String> = close.iter().map(|c| format!("`{c}`")).collect();
+        format!("did you mean {}?", quoted.join(" or "))
     }
 }
 
