@@ -206,6 +206,9 @@ const LEGEND_WIDTH: u32 = 130;
 const FIG_WIDTH: u32 = 1100;
 const FIG_LEGEND_WIDTH: u32 = 230;
 const PANEL_HEIGHT: u32 = 250;
+/// Left edge (px) of a model plot's legend: every legend entry's text starts right of it,
+/// every other text left of it.
+pub const LEGEND_LEFT: u32 = FIG_WIDTH - FIG_LEGEND_WIDTH;
 
 fn font() -> Result<(), PlotError> {
     static REGISTERED: OnceLock<bool> = OnceLock::new();
