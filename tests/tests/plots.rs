@@ -12,7 +12,13 @@ fn svg_texts(svg: &str) -> Vec<(f64, String)> {
         .skip(1)
         .filter_map(|t| {
             let (attrs, rest) = t.split_once('>')?;
-            let x = attrs.split("x=\"").nth(1)?.split('"').next()?.parse().ok()?;
+            let x = attrs
+                .split("x=\"")
+                .nth(1)?
+                .split('"')
+                .next()?
+                .parse()
+                .ok()?;
             let body = rest.split("</text>").next()?.trim();
             let body = body
                 .replace("&lt;", "<")
@@ -26,13 +32,20 @@ fn svg_texts(svg: &str) -> Vec<(f64, String)> {
         .collect()
 }
 
-/// Number of points of each `<polyline>` of an SVG.
-fn polylines(svg: &str) -> Vec<usize> {
+/// Number of points and stroke width of each `<polyline>` of an SVG.
+fn polylines(svg: &str) -> Vec<(usize, u32)> {
     svg.split("<polyline")
         .skip(1)
         .filter_map(|p| {
+            let width = p
+                .split("stroke-width=\"")
+                .nth(1)?
+                .split('"')
+                .next()?
+                .parse()
+                .ok()?;
             let pts = p.split("points=\"").nth(1)?.split('"').next()?;
-            Some(pts.split_whitespace().count())
+            Some((pts.split_whitespace().count(), width))
         })
         .collect()
 }
@@ -108,29 +121,50 @@ fn every_model_has_plots_that_render_to_png_and_svg() {
                     .count()
             };
             let fewest = plot.panels.iter().map(rows).min().unwrap();
-            assert!(fewest >= 10, "{name}/{}: {fewest} rows in a panel", plot.file);
+            assert!(
+                fewest >= 10,
+                "{name}/{}: {fewest} rows in a panel",
+                plot.file
+            );
             let long = polylines(&svg)
                 .into_iter()
-                .filter(|&n| n * 10 >= fewest * 9)
+                .filter(|&(n, _)| n * 10 >= fewest * 9)
                 .count();
-            let solid = plot
-                .panels
-                .iter()
-                .flat_map(|p| p.series.iter())
-                .filter(|s| !s.dashed)
-                .count();
-            assert_eq!(long, solid, "{name}/{}: curves drawn", plot.file);
+            assert_eq!(
+                long,
+                solid_count(plot),
+                "{name}/{}: curves drawn",
+                plot.file
+            );
+            // the dashes: thin (2 px) short polylines besides the legend's (one per solid
+            // series of a panel without dashed ones, two per dashed series)
             let dashed = plot
                 .panels
                 .iter()
                 .flat_map(|p| p.series.iter())
                 .filter(|s| s.dashed)
                 .count();
-            let short = polylines(&svg)
+            let legend_thin: usize = plot
+                .panels
+                .iter()
+                .map(|p| {
+                    let d = p.series.iter().filter(|s| s.dashed).count();
+                    if d == 0 {
+                        p.series.len()
+                    } else {
+                        2 * d
+                    }
+                })
+                .sum();
+            let thin = polylines(&svg)
                 .into_iter()
-                .filter(|&n| n * 10 < fewest * 9)
+                .filter(|&(n, w)| w == 2 && n * 10 < fewest * 9)
                 .count();
-            assert!(short >= 10 * dashed, "{name}/{}: dashes drawn", plot.file);
+            assert!(
+                thin >= legend_thin + 10 * dashed,
+                "{name}/{}: {thin} thin polylines for {dashed} dashed series",
+                plot.file
+            );
             drawn += 1;
         }
     }
@@ -142,4 +176,12 @@ fn tempfile_dir() -> std::path::PathBuf {
     let d = std::env::temp_dir().join(format!("bg-plots-{}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
     d
+}
+
+fn solid_count(plot: &bg_model::Plot) -> usize {
+    plot.panels
+        .iter()
+        .flat_map(|p| p.series.iter())
+        .filter(|s| !s.dashed)
+        .count()
 }
