@@ -213,3 +213,93 @@ fn run_with_plots_draws_after_the_run() {
     assert_eq!(files.len(), 10, "{files:?}");
     assert!(files.iter().all(|p| is_png(p)));
 }
+
+/// Every runnable model in `models/`: `run --plots` draws its `[[plot]]` figures as PNG and
+/// SVG, and `plot --columns` gives a quick look at the CSV the run wrote.
+#[test]
+fn every_model_runs_with_its_plots_and_its_csv_can_be_looked_at() {
+    let models = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../models");
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(&models)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    paths.sort();
+    let dir = tempfile::tempdir().unwrap();
+    let mut n = 0;
+    for model in paths {
+        let name = model.file_stem().unwrap().to_string_lossy().into_owned();
+        if name == "algebraic_loop" || name == "derivative_causality" {
+            continue; // refused by design
+        }
+        let csv = dir.path().join(format!("{name}.csv"));
+        let figs = dir.path().join(&name);
+        let o = bg_sim()
+            .arg("run")
+            .arg(&model)
+            .arg("-o")
+            .arg(&csv)
+            .args(["--quiet", "--plot-format", "both", "--plots"])
+            .arg(&figs)
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let files = pngs(&figs);
+        assert!(files.len() >= 2, "{name}: {files:?}");
+        assert_eq!(
+            files
+                .iter()
+                .filter(|p| p.extension().unwrap() == "png")
+                .count(),
+            files
+                .iter()
+                .filter(|p| p.extension().unwrap() == "svg")
+                .count(),
+            "{name}: {files:?}"
+        );
+        for f in &files {
+            if f.extension().unwrap() == "png" {
+                assert!(is_png(f), "{}", f.display());
+            } else {
+                let svg = std::fs::read_to_string(f).unwrap();
+                assert!(
+                    svg.starts_with("<svg") && svg.contains("<polyline"),
+                    "{}",
+                    f.display()
+                );
+            }
+        }
+        // a quick look at (up to) the first four columns after t
+        let header = std::fs::read_to_string(&csv).unwrap();
+        let columns: Vec<&str> = header
+            .lines()
+            .next()
+            .unwrap()
+            .split(',')
+            .skip(1)
+            .take(4)
+            .collect();
+        let look = dir.path().join("look");
+        let o = bg_sim()
+            .arg("plot")
+            .arg(&csv)
+            .arg("--columns")
+            .arg(columns.join(","))
+            .arg("-o")
+            .arg(&look)
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(is_png(&look.join(format!("{name}.png"))), "{name}");
+        n += 1;
+    }
+    assert!(n >= 7, "only {n} models");
+}
