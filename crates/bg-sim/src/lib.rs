@@ -2,12 +2,13 @@
 //! knows, shared by the CLI and the workspace tests, the figures of a results CSV
 //! ([`plot`]), the speed–accuracy measurements of `bench` ([`bench`](mod@bench)), the scene search
 //! of `reduce` ([`reduce`]), the time-scale report of `bg-sim modes` ([`modes`]) and
-//! sweeps: many runs of one model in parallel, one summary row each ([`sweep`]). No physics
-//! lives here.
+//! sweeps: many runs of one model in parallel, one summary row each ([`sweep`]), and the
+//! drawing of a model's bond graph (`bg-sim graph`, [`graph`](mod@graph)). No physics lives here.
 
 use bg_model::Registry;
 
 pub mod bench;
+pub mod graph;
 pub mod modes;
 pub mod plot;
 pub mod reduce;

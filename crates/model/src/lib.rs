@@ -26,7 +26,8 @@
 //! [`Model::load`] parses, applies `--set` overrides ([`overrides::apply`]), builds every
 //! element through the [`Registry`], assigns causality and assembles the equations. Every
 //! failure is a [`ModelError`] with file, line, column, element and hint.
-//! [`inspect`] goes as far as it can and reports what it found (`bg-sim check`).
+//! [`inspect`] goes as far as it can and reports what it found (`bg-sim check`);
+//! [`structure`] stops at the bond graph and its causality, for drawing (`bg-sim graph`).
 //!
 //! ## Scene switches
 //! `[scene]` declares the switches between richer and cheaper scenes (modes, lumped masses,
@@ -50,7 +51,7 @@ pub mod scene;
 pub mod steady;
 
 pub use error::{ErrorKind, ModelError};
-pub use load::{inspect, Check, CheckResult, Inspection, Model};
+pub use load::{inspect, structure, Check, CheckResult, Entry, Inspection, Model, Structure};
 pub use registry::{
     BuildFn, Builder, Composite, CompositeFn, ElementSpec, KindInfo, RawValue, Registry,
 };

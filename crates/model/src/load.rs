@@ -20,6 +20,9 @@ use crate::expr::{Expr, RESERVED};
 use crate::registry::{ElementSpec, RawValue, Registry};
 use crate::scene::Scene;
 
+mod structure;
+pub use structure::{structure, Entry, Structure};
+
 type SpannedMap<V> = IndexMap<Spanned<String>, Spanned<V>>;
 
 #[derive(Deserialize)]
