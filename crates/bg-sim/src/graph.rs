@@ -462,7 +462,7 @@ fn arrange(d: &Drawing, stubs: &[Vec<Stub>]) -> Geometry {
         })
         .collect();
     let sp = Spacing {
-        column: 70.0,
+        column: 90.0,
         row: 26.0,
         margin: 20.0,
     };
@@ -584,9 +584,22 @@ fn unit(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
 #[must_use]
 pub fn svg(d: &Drawing) -> String {
     let geo = place(d);
-    let head = 28.0;
+    let legend1 = "⇀ half-arrow: direction of positive power (from → to)   | causal stroke: at the end that receives the effort";
+    let legend2 = "- - ▸ signal read by an element   [n] multibond of n efforts and flows";
+    let problem = d
+        .problem
+        .as_ref()
+        .map(|p| format!("no causal strokes: {p}"));
+    let head = if problem.is_some() { 44.0 } else { 28.0 };
     let legend = 40.0;
-    let width = geo.width.max(560.0);
+    let width = [
+        geo.width,
+        text_w(legend1, SMALL) + 40.0,
+        text_w(&d.title, 14.0) + 40.0,
+        problem.as_deref().map_or(0.0, |p| text_w(p, SMALL) + 40.0),
+    ]
+    .into_iter()
+    .fold(0.0, f64::max);
     let height = geo.height + head + legend;
     let mut o = String::new();
     let _ = writeln!(
@@ -711,19 +724,20 @@ pub fn svg(d: &Drawing) -> String {
             (&b.ports[1], tip, pts[last - 1]),
         ] {
             if let Some(port) = port {
-                let (ux, uy) = unit(towards, at);
+                // just outside the box, above the bond
+                let (ux, uy) = unit(at, towards);
                 let anchor = if ux > 0.3 {
-                    "end"
-                } else if ux < -0.3 {
                     "start"
+                } else if ux < -0.3 {
+                    "end"
                 } else {
                     "middle"
                 };
                 let _ = writeln!(
                     o,
                     r##"<text class="port" x="{:.1}" y="{:.1}" font-size="{SMALL}" fill="#a40" text-anchor="{anchor}">{}</text>"##,
-                    at.0 + 6.0 * ux,
-                    at.1 + 10.0 * uy + 3.0,
+                    at.0 + 4.0 * ux,
+                    at.1 + 4.0 * uy - 6.0,
                     esc(port)
                 );
             }
@@ -787,18 +801,22 @@ pub fn svg(d: &Drawing) -> String {
         let _ = writeln!(o, "</g>");
     }
     let _ = writeln!(o, "</g>");
+    if let Some(p) = &problem {
+        let _ = writeln!(
+            o,
+            r##"<text class="problem" x="20" y="38" font-size="{SMALL}" fill="#b00">{}</text>"##,
+            esc(p)
+        );
+    }
     // legend
     let ly = head + geo.height + 14.0;
-    let note = match &d.problem {
-        Some(p) => format!("no causal strokes: {p}"),
-        None => "| causal stroke: at the end that receives the effort".to_owned(),
-    };
     let _ = writeln!(
         o,
-        r##"<text x="20" y="{ly:.1}" font-size="{SMALL}" fill="#444">⇀ half-arrow: direction of positive power (from → to)   {}</text>
-<text x="20" y="{:.1}" font-size="{SMALL}" fill="#444">- - ▸ signal read by an element   [n] multibond of n efforts and flows</text>"##,
-        esc(&note),
-        ly + 14.0
+        r##"<text x="20" y="{ly:.1}" font-size="{SMALL}" fill="#444">{}</text>
+<text x="20" y="{:.1}" font-size="{SMALL}" fill="#444">{}</text>"##,
+        esc(legend1),
+        ly + 14.0,
+        esc(legend2)
     );
     let _ = writeln!(o, "</svg>");
     o
