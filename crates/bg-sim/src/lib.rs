@@ -3,7 +3,8 @@
 //! ([`plot`]), the speed–accuracy measurements of `bench` ([`bench`](mod@bench)), the scene search
 //! of `reduce` ([`reduce`]), the time-scale report of `bg-sim modes` ([`modes`]) and
 //! sweeps: many runs of one model in parallel, one summary row each ([`sweep`]), and the
-//! drawing of a model's bond graph (`bg-sim graph`, [`graph`](mod@graph)). No physics lives here.
+//! drawing of a model's bond graph (`bg-sim graph`, [`graph`](mod@graph)), and the progress
+//! bar of `bg-sim run` ([`progress`]). No physics lives here.
 
 use bg_model::Registry;
 
@@ -11,6 +12,7 @@ pub mod bench;
 pub mod graph;
 pub mod modes;
 pub mod plot;
+pub mod progress;
 pub mod reduce;
 pub mod sweep;
 

@@ -1022,7 +1022,16 @@ fn run(
         }
     }
     model.settings.interrupt = Some(interrupt_on_signals());
-    let (outcome, checks) = match model.run_into(&mut sink) {
+    let mut progress = bg_sim::progress::Progress::new(
+        &mut sink,
+        model.settings.t_start,
+        model.settings.t_end,
+        !quiet && std::io::IsTerminal::is_terminal(&std::io::stderr()),
+        !model.checks.is_empty(),
+    );
+    let ran = model.run_into(&mut progress);
+    drop(progress);
+    let (outcome, checks) = match ran {
         Ok(r) => r,
         Err(e) => {
             let _ = std::fs::remove_file(&partial);
