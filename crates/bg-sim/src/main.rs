@@ -143,6 +143,24 @@ enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
     },
+    /// Draw a model's bond graph as SVG (or Graphviz DOT): element symbols, half-arrows,
+    /// causal strokes, signals; composites as one box each unless --expand (docs/graph.md).
+    Graph {
+        /// The model file.
+        model: PathBuf,
+        /// Output file (default: out/<model name>.svg, or .dot).
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Draw the members of every composite inside a frame instead of one box.
+        #[arg(long)]
+        expand: bool,
+        /// svg or dot (default: from the extension of --output, else svg).
+        #[arg(long, value_enum)]
+        format: Option<bg_sim::graph::Format>,
+        /// Override a value of the model file (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+    },
     /// List the element kinds a model file can use, or describe one: its ports, parameters
     /// (units, defaults, ranges), states and published signals.
     Kinds {
@@ -363,6 +381,13 @@ fn dispatch(command: Command) -> ExitCode {
             }
         }
         Command::Check { model, set } => check(&model, &set),
+        Command::Graph {
+            model,
+            output,
+            expand,
+            format,
+            set,
+        } => graph(&model, output.as_deref(), expand, format, &set),
         Command::Modes {
             model,
             at,
@@ -505,6 +530,28 @@ fn dispatch(command: Command) -> ExitCode {
             t_end,
             set: &set,
         }),
+    }
+}
+
+fn graph(
+    model: &Path,
+    out: Option<&Path>,
+    expand: bool,
+    format: Option<bg_sim::graph::Format>,
+    set: &[String],
+) -> ExitCode {
+    match bg_sim::graph::write(model, out, expand, format, set) {
+        Ok(w) => {
+            if let Some(p) = &w.problem {
+                tell!("note: drawn without causal strokes: {p}");
+            }
+            say!("{} nodes, {} bonds: {}", w.nodes, w.bonds, w.path.display());
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            tell!("error: {e}");
+            ExitCode::from(BAD_INPUT)
+        }
     }
 }
 
@@ -1071,7 +1118,16 @@ fn run(
         }
     }
     model.settings.interrupt = Some(interrupt_on_signals());
-    let (outcome, checks) = match model.run_into(&mut sink) {
+    let mut progress = bg_sim::progress::Progress::new(
+        &mut sink,
+        model.settings.t_start,
+        model.settings.t_end,
+        !quiet && std::io::IsTerminal::is_terminal(&std::io::stderr()),
+        !model.checks.is_empty(),
+    );
+    let ran = model.run_into(&mut progress);
+    drop(progress);
+    let (outcome, checks) = match ran {
         Ok(r) => r,
         Err(e) => {
             let _ = std::fs::remove_file(&partial);

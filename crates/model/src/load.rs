@@ -21,6 +21,9 @@ use crate::reader::{ElementSpec, RawValue};
 use crate::registry::Registry;
 use crate::scene::Scene;
 
+mod structure;
+pub use structure::{structure, Entry, Structure};
+
 type SpannedMap<V> = IndexMap<Spanned<String>, Spanned<V>>;
 
 #[derive(Deserialize)]
