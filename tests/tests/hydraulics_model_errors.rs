@@ -121,3 +121,56 @@ tol = 0.0
     assert!(e.message.contains("side"), "{e}");
     assert_eq!(e.line, Some(3));
 }
+
+fn circuit_with(from: &str, to: &str) -> Result<Model, bg_model::ModelError> {
+    let text = std::fs::read_to_string(model_path("accumulator_circuit")).unwrap();
+    assert!(text.contains(from), "{from}");
+    Model::from_text(
+        "circuit.toml",
+        &text.replacen(from, to, 1),
+        &registry(),
+        &[],
+    )
+}
+
+#[test]
+fn storage_kinds_refuse_bad_parameters_with_the_key() {
+    assert!(circuit_with("", "").is_ok());
+    let bad = [
+        (r#"segments = "n_seg""#, "segments = 2.5", "segments"),
+        (r#"segments = "n_seg""#, "segments = 0", "segments"),
+        (r#"segments = "n_seg""#, "segments = 5000", "segments"),
+        (
+            r#"diameter = "d""#,
+            r#"diameter = "d", k_wall = 1e-9, e_wall = 2e11"#,
+            "k_wall",
+        ),
+        (
+            r#"diameter = "d""#,
+            r#"diameter = "d", e_wall = 2e11"#,
+            "wall_thickness",
+        ),
+        (r#"diameter = "d""#, "diameter = 0.0", "diameter"),
+        (
+            r#"p_init = "p_start""#,
+            r#"p_init = "p_start", v_oil0 = 1e-4"#,
+            "v_oil0",
+        ),
+        (r#"v0 = "v0", n = 1.4"#, r#"v0 = "v0", n = 0.5"#, "n"),
+        (r#"p_init = "p_start""#, "v_oil0 = 1e-3", "v_oil0"),
+        ("air_fraction = 0.002", "air_fraction = 1.0", "air_fraction"),
+        ("air_fraction = 0.002, ", "n_air = 1.2, ", "n_air"),
+        ("cavitation = true", "cavitation = false", "p_vapour"),
+        ("cavitation = true", "cavitation = 1", "cavitation"),
+        (r#"p0 = "p_c0""#, "p0 = -1e5", "p0"),
+        ("v_nominal = 1e-6", "v_nominal = 0.0", "v_nominal"),
+    ];
+    for (from, to, key) in bad {
+        let e = circuit_with(from, to).unwrap_err();
+        assert!(
+            e.message.contains(key),
+            "{from} → {to}: {e} does not name {key}"
+        );
+        assert!(e.element.is_some(), "{e}");
+    }
+}

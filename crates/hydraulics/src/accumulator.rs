@@ -35,6 +35,7 @@
 //!
 //! Causality: integral (the accumulator sets its pressure); derivative causality is refused.
 
+use bondgraph::kind::{BuildError, KindDecl, ParamDecl, Params, Range};
 use bondgraph::{
     CausalRule, Element, Io, LocalJacobian, ParamError, PortCausality, PortSpec, Ports, Slot,
     Stage, StateSpec,
@@ -265,6 +266,56 @@ impl Element for Accumulator {
     fn stored_energy(&self, x: &[f64]) -> Option<f64> {
         Some(self.energy(x[0]))
     }
+}
+
+/// Kind `hydraulics.accumulator`.
+pub const KIND: KindDecl = KindDecl::element(
+    "hydraulics.accumulator",
+    "gas accumulator, C with oil-volume state: (p + p_atm)(V₀ − V)ⁿ = (p₀ + p_atm)V₀ⁿ, stiff oil below p₀",
+    &[
+        ParamDecl::number("p0", "Pa", "precharge pressure (gauge), p0 + p_atm > 0"),
+        ParamDecl::number("v0", "m³", "gas volume at precharge (the accumulator's size)").positive(),
+        ParamDecl::number("n", "1", "polytropic exponent (1 isothermal, 1.4 adiabatic)")
+            .range(Range::closed(1.0, 2.0))
+            .default(1.4),
+        ParamDecl::number("p_atm", "Pa", "atmospheric pressure, absolute")
+            .positive()
+            .default(101_325.0),
+        ParamDecl::number("beta", "Pa", "oil bulk modulus of the empty accumulator")
+            .positive()
+            .default(1.5e9),
+        ParamDecl::number("v_dead", "m³", "oil left in neck and port when empty")
+            .positive()
+            .optional("1e-3 of v0"),
+        ParamDecl::number("p_init", "Pa", "initial pressure (gauge)")
+            .optional("p0: empty at precharge"),
+        ParamDecl::number("v_oil0", "m³", "initial oil volume, below 0.999·v0, instead of p_init")
+            .optional("0: empty at precharge"),
+    ],
+    build,
+)
+.example("p0 = 5e6, v0 = 4e-3, p_init = 8e6");
+
+fn build(p: &dyn Params) -> Result<Box<dyn Element>, BuildError> {
+    let v0 = p.number("v0")?;
+    let mut a = Accumulator::new(p.number("p0")?, v0, p.number("n")?)?
+        .with_atmosphere(p.number("p_atm")?)?;
+    if p.has("beta") || p.has("v_dead") {
+        let v_dead = p.optional("v_dead")?.unwrap_or(1e-3 * v0);
+        a = a.with_empty_oil(p.number("beta")?, v_dead)?;
+    }
+    let a = match (p.optional("p_init")?, p.optional("v_oil0")?) {
+        (Some(_), Some(_)) => {
+            return Err(BuildError::conflict(
+                "v_oil0",
+                "give either `p_init` or `v_oil0`, not both",
+            ))
+        }
+        (Some(pi), None) => a.with_pressure(pi)?,
+        (None, Some(v)) => a.with_oil_volume(v)?,
+        (None, None) => a,
+    };
+    Ok(Box::new(a))
 }
 
 #[cfg(test)]

@@ -39,7 +39,7 @@
 //! above the vapour pressure, the chamber also publishes `V_cav` (m³), and the minimum
 //! pressure is still recorded but no longer warned about.
 
-use crate::fluid::{Cavitation, EntrainedAir, Fluid, FluidOptions};
+use crate::fluid::{self, Cavitation, EntrainedAir, Fluid, FluidOptions};
 use bondgraph::kind::{BuildError, KindDecl, ParamDecl, Params};
 use bondgraph::{
     CausalRule, Element, Io, LocalJacobian, Param, ParamError, PortCausality, PortSpec, Ports,
@@ -326,7 +326,7 @@ impl Element for Chamber {
 /// Kind `hydraulics.chamber`.
 pub const KIND: KindDecl = KindDecl::element(
     "hydraulics.chamber",
-    "oil volume, C with pressure state: dP/dt = β/V(s)·Q, V = A(l⁰ ± s) or fixed; publishes V",
+    "oil volume, C with pressure state: dP/dt = β/V(s)·Q, V = A(l⁰ ± s) or fixed; publishes V; options: entrained air, cavitation",
     &[
         ParamDecl::choice(
             "side",
@@ -358,6 +358,12 @@ pub const KIND: KindDecl = KindDecl::element(
         ParamDecl::number("p_nominal", "Pa", "tolerance scale of the pressure state")
             .positive()
             .default(1e6),
+        fluid::AIR_FRACTION,
+        fluid::N_AIR,
+        fluid::CAVITATION,
+        fluid::P_VAPOUR,
+        fluid::P_CAV_BAND,
+        fluid::P_ATM,
     ],
     build,
 )
@@ -394,7 +400,8 @@ fn build(p: &dyn Params) -> Result<Box<dyn Element>, BuildError> {
     }
     let c = c
         .with_tank_pressure(p.number("p_tank")?)?
-        .with_nominal_pressure(p.number("p_nominal")?)?;
+        .with_nominal_pressure(p.number("p_nominal")?)?
+        .with_fluid(fluid::options(p)?)?;
     Ok(Box::new(c))
 }
 

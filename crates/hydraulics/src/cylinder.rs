@@ -23,7 +23,7 @@
 use bondgraph::kind::{member_name, BuildError, KindDecl, ParamDecl, Params};
 use bondgraph::{BondGraph, Composite, Error, OneJunction, Param, ParamError, ZeroJunction};
 
-use crate::orifice;
+use crate::{fluid, orifice};
 
 use crate::{Chamber, EndStop, FluidOptions, Leakage, Piston, Side, Valve};
 
@@ -392,6 +392,12 @@ pub const KIND: KindDecl = KindDecl::composite(
         ParamDecl::number("stop_width", "m", "end-stop contact width")
             .positive()
             .default(1e-5),
+        fluid::AIR_FRACTION,
+        fluid::N_AIR,
+        fluid::CAVITATION,
+        fluid::P_VAPOUR,
+        fluid::P_CAV_BAND,
+        fluid::P_ATM,
     ],
     build,
 )
@@ -414,6 +420,7 @@ fn build(p: &dyn Params) -> Result<Composite, BuildError> {
     c.p_t = p.number("p_t")?;
     c.r_int = p.optional("r_int")?;
     c.r_ext = p.optional("r_ext")?;
+    c.fluid = fluid::options(p)?;
     c.initial = if p.has("p_p0") || p.has("p_r0") {
         if let Some(k) = ["hold_force", "p_pre"].into_iter().find(|k| p.has(k)) {
             return Err(BuildError::conflict(

@@ -55,6 +55,7 @@
 //! jump over the band (a continuation of g below p_v that stayed positive let Radau step
 //! from 0.2 MPa straight to −0.2 MPa gauge in a test).
 
+use bondgraph::kind::{BuildError, ParamDecl, Params};
 use bondgraph::ParamError;
 
 /// Entrained (undissolved) air: volume fraction `fraction` ε of the mixture at the
@@ -151,6 +152,88 @@ impl FluidOptions {
     pub fn any(&self) -> bool {
         self.air.is_some() || self.cavitation.is_some()
     }
+}
+
+/// Atmospheric pressure (`p_atm`), declared once for the chamber and the cylinder.
+pub const P_ATM: ParamDecl = ParamDecl::number(
+    "p_atm",
+    "Pa",
+    "atmospheric pressure, absolute (gauge → absolute; with air or cavitation)",
+)
+.positive()
+.default(101_325.0);
+/// Volume fraction of free air at p_atm (`air_fraction`).
+pub const AIR_FRACTION: ParamDecl = ParamDecl::number(
+    "air_fraction",
+    "1",
+    "entrained air: volume fraction ε of free air at p_atm, in [0, 1)",
+)
+.non_negative()
+.optional("no entrained air");
+/// Polytropic exponent of the air (`n_air`).
+pub const N_AIR: ParamDecl = ParamDecl::number(
+    "n_air",
+    "1",
+    "polytropic exponent of the entrained air, ≥ 1 (1 isothermal, 1.4 adiabatic)",
+)
+.positive()
+.default(1.4);
+/// Whether cavitation is represented (`cavitation`).
+pub const CAVITATION: ParamDecl = ParamDecl::flag(
+    "cavitation",
+    false,
+    "represent cavitation: a cavity near p_vapour keeps the pressure above it",
+);
+/// Vapour pressure (`p_vapour`).
+pub const P_VAPOUR: ParamDecl = ParamDecl::number(
+    "p_vapour",
+    "Pa",
+    "vapour pressure, absolute (with cavitation)",
+)
+.non_negative()
+.default(1e3);
+/// Width of the cavitation band (`p_cav_band`).
+pub const P_CAV_BAND: ParamDecl = ParamDecl::number(
+    "p_cav_band",
+    "Pa",
+    "width p_c of the cavitation band (with cavitation)",
+)
+.positive()
+.default(1e3);
+
+/// The fluid options a chamber or cylinder declares ([`P_ATM`], [`AIR_FRACTION`],
+/// [`N_AIR`], [`CAVITATION`], [`P_VAPOUR`], [`P_CAV_BAND`]); the keys of an option that is
+/// off are refused rather than ignored.
+pub fn options(p: &dyn Params) -> Result<FluidOptions, BuildError> {
+    let mut o = FluidOptions {
+        p_atm: p.number("p_atm")?,
+        ..FluidOptions::default()
+    };
+    if let Some(fraction) = p.optional("air_fraction")? {
+        o.air = Some((fraction, p.number("n_air")?));
+    } else if p.has("n_air") {
+        return Err(BuildError::conflict(
+            "n_air",
+            "`n_air` needs entrained air: give `air_fraction` too",
+        ));
+    }
+    if p.flag("cavitation")? {
+        o.cavitation = Some((p.number("p_vapour")?, p.number("p_cav_band")?));
+    } else if let Some(k) = ["p_vapour", "p_cav_band"].into_iter().find(|k| p.has(k)) {
+        return Err(BuildError::conflict(
+            k,
+            format!("`{k}` is a cavitation parameter, but cavitation is off"),
+        )
+        .hint("add `cavitation = true` to represent cavitation"));
+    }
+    if !o.any() && p.has("p_atm") {
+        return Err(BuildError::conflict(
+            "p_atm",
+            "`p_atm` is used only with entrained air or cavitation",
+        )
+        .hint("add `air_fraction = …` or `cavitation = true`, or remove `p_atm`"));
+    }
+    Ok(o)
 }
 
 /// The absolute pressure below which entrained air is evaluated at this floor (Pa): only a

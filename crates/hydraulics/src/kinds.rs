@@ -3,7 +3,9 @@
 
 use bondgraph::KindDecl;
 
-use crate::{chamber, cylinder, end_stop, leakage, orifice, piston, valve};
+use crate::{
+    accumulator, chamber, cylinder, end_stop, leakage, line, orifice, piston, tank, valve,
+};
 
 /// Every kind of this crate.
 pub const KINDS: &[KindDecl] = &[
@@ -15,4 +17,7 @@ pub const KINDS: &[KindDecl] = &[
     orifice::KIND,
     valve::KIND,
     cylinder::KIND,
+    accumulator::KIND,
+    line::KIND,
+    tank::KIND,
 ];

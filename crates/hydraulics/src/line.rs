@@ -38,6 +38,7 @@
 //! between two chambers has its `a` end at the upstream element that sets flow; turn it round
 //! (swap `a` and `b` in the bonds) if the causality is the other way.
 
+use bondgraph::kind::{BuildError, KindDecl, ParamDecl, Params, Range};
 use bondgraph::{
     CausalRule, Element, Io, LocalJacobian, ParamError, PortCausality, PortSpec, Ports, Slot,
     Stage, StateSpec,
@@ -300,6 +301,84 @@ impl Element for Line {
         let e_q: f64 = q.iter().map(|q| q * q).sum::<f64>() * self.i / 2.0;
         Some(e_p + e_q)
     }
+}
+
+/// Kind `hydraulics.line`.
+pub const KIND: KindDecl = KindDecl::element(
+    "hydraulics.line",
+    "pipe or hose, N lumped C–R–I segments (Hagen–Poiseuille, inertance ρℓ/A, wall compliance); port a sets p, b sets Q",
+    &[
+        ParamDecl::number("length", "m", "length ℓ").positive(),
+        ParamDecl::number("diameter", "m", "bore d").positive(),
+        ParamDecl::number("beta", "Pa", "oil bulk modulus β").positive(),
+        ParamDecl::count("segments", "number of segments N, 1 … 2000 (two states each)")
+            .range(Range::closed(1.0, 2000.0))
+            .default(10.0),
+        ParamDecl::number("rho", "kg/m³", "oil density").positive().default(870.0),
+        ParamDecl::number("mu", "Pa·s", "dynamic viscosity (0: lossless)")
+            .non_negative()
+            .default(0.028),
+        ParamDecl::number("wall_thickness", "m", "pipe wall thickness e (with e_wall)")
+            .positive()
+            .optional("rigid wall"),
+        ParamDecl::number("e_wall", "Pa", "Young's modulus E of the pipe wall (with wall_thickness)")
+            .positive()
+            .optional("rigid wall"),
+        ParamDecl::number("k_wall", "1/Pa", "hose: volumetric expansion per pressure")
+            .non_negative()
+            .optional("rigid wall"),
+        ParamDecl::number("p0", "Pa", "initial pressure of every segment").default(0.0),
+        ParamDecl::number("p_nominal", "Pa", "tolerance scale of the pressure states")
+            .positive()
+            .default(1e6),
+        ParamDecl::number("q_nominal", "m³/s", "tolerance scale of the flow states")
+            .positive()
+            .default(1e-4),
+    ],
+    build,
+)
+.example("length = 5.0, diameter = 0.01, beta = 1.5e9, segments = 4");
+
+fn build(p: &dyn Params) -> Result<Box<dyn Element>, BuildError> {
+    let pipe = p.has("wall_thickness") || p.has("e_wall");
+    let wall = match (pipe, p.has("k_wall")) {
+        (true, true) => return Err(BuildError::conflict(
+            "k_wall",
+            "give either a pipe wall (`wall_thickness`, `e_wall`) or a hose's `k_wall`, not both",
+        )),
+        (true, false) => {
+            let (Some(thickness), Some(modulus)) =
+                (p.optional("wall_thickness")?, p.optional("e_wall")?)
+            else {
+                let k = if p.has("e_wall") {
+                    "wall_thickness"
+                } else {
+                    "e_wall"
+                };
+                return Err(BuildError::missing(
+                    k,
+                    "a pipe wall needs both `wall_thickness` and `e_wall`",
+                ));
+            };
+            Wall::Pipe { thickness, modulus }
+        }
+        (false, true) => Wall::Hose {
+            expansion: p.number("k_wall")?,
+        },
+        (false, false) => Wall::Rigid,
+    };
+    let spec = LineSpec {
+        length: p.number("length")?,
+        diameter: p.number("diameter")?,
+        segments: p.count("segments")?,
+        beta: p.number("beta")?,
+        rho: p.number("rho")?,
+        mu: p.number("mu")?,
+        wall,
+    };
+    let line = Line::new(&spec, p.number("p0")?)?
+        .with_nominal(p.number("p_nominal")?, p.number("q_nominal")?)?;
+    Ok(Box::new(line))
 }
 
 #[cfg(test)]

@@ -15,6 +15,7 @@
 //! Causality: fixed, the tank sets the pressure of its port (like Se). Several returns share
 //! one tank through a 0-junction.
 
+use bondgraph::kind::{BuildError, KindDecl, ParamDecl, Params};
 use bondgraph::{
     CausalRule, Element, Io, LocalJacobian, ParamError, PortCausality, PortSpec, Ports, Slot,
     Stage, StateSpec,
@@ -81,6 +82,27 @@ impl Element for Tank {
         jac.set(jac.derivative_row(0), jac.flow_col(0, 0), 1.0);
         true
     }
+}
+
+/// Kind `hydraulics.tank`.
+pub const KIND: KindDecl = KindDecl::element(
+    "hydraulics.tank",
+    "tank at constant pressure p that counts the volume it receives: state V = ∫ f_in dt",
+    &[
+        ParamDecl::number("p", "Pa", "tank pressure (gauge)").default(0.0),
+        ParamDecl::number("v0", "m³", "volume counted at the start").default(0.0),
+        ParamDecl::number("v_nominal", "m³", "tolerance scale of the volume state")
+            .positive()
+            .default(1e-3),
+    ],
+    build,
+)
+.example("p = 0.0");
+
+fn build(p: &dyn Params) -> Result<Box<dyn Element>, BuildError> {
+    let t =
+        Tank::new(p.number("p")?, p.number("v0")?)?.with_nominal_volume(p.number("v_nominal")?)?;
+    Ok(Box::new(t))
 }
 
 #[cfg(test)]
