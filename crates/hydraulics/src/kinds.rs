@@ -3,7 +3,7 @@
 
 use bondgraph::KindDecl;
 
-use crate::{chamber, cylinder, end_stop, leakage, orifice, piston, valve};
+use crate::{chamber, cylinder, end_stop, laminar, leakage, orifice, piston, valve};
 
 /// Every kind of this crate.
 pub const KINDS: &[KindDecl] = &[
@@ -15,4 +15,5 @@ pub const KINDS: &[KindDecl] = &[
     orifice::KIND,
     valve::KIND,
     cylinder::KIND,
+    laminar::KIND,
 ];
