@@ -4,7 +4,7 @@
 use bondgraph::KindDecl;
 
 use crate::{
-    accumulator, chamber, cylinder, end_stop, leakage, line, orifice, piston, tank, valve,
+    accumulator, chamber, cylinder, end_stop, laminar, leakage, line, orifice, piston, tank, valve,
 };
 
 /// Every kind of this crate.
@@ -17,6 +17,7 @@ pub const KINDS: &[KindDecl] = &[
     orifice::KIND,
     valve::KIND,
     cylinder::KIND,
+    laminar::KIND,
     accumulator::KIND,
     line::KIND,
     tank::KIND,

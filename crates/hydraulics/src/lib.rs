@@ -29,6 +29,7 @@
 //! - [`Piston`] (`hydraulics.piston`): the TF pair A_p, A_r (eqs. 80–81) and the stroke.
 //! - [`EndStop`] (`hydraulics.end_stop`): stiff spring–damper past the stroke ends.
 //! - [`Leakage`] (`hydraulics.leakage`, `hydraulics.tank_leakage`): laminar R (eq. 82).
+//! - [`Laminar`] (`hydraulics.laminar`): a pipe's laminar resistance (Hagen–Poiseuille).
 //! - [`Orifice`] (`hydraulics.orifice`) and [`Valve`] (`hydraulics.valve`): eqs. 29–31 with
 //!   the square root regularised by [`reg_root`].
 //!
@@ -59,6 +60,7 @@ pub mod cylinder;
 pub mod end_stop;
 pub mod fluid;
 pub mod kinds;
+pub mod laminar;
 pub mod leakage;
 pub mod line;
 pub mod orifice;
@@ -74,6 +76,7 @@ pub use cylinder::{
 pub use end_stop::EndStop;
 pub use fluid::{Fluid, FluidOptions};
 pub use kinds::KINDS;
+pub use laminar::{pipe_resistance, Laminar};
 pub use leakage::Leakage;
 pub use line::{Line, LineSpec, Wall};
 pub use orifice::{alpha, reg_root, reg_root_derivative, Orifice};
