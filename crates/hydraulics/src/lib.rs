@@ -49,8 +49,10 @@
 pub mod chamber;
 pub mod cylinder;
 pub mod end_stop;
+pub mod friction;
 pub mod kinds;
 pub mod leakage;
+pub mod machine;
 pub mod orifice;
 pub mod piston;
 pub mod valve;
@@ -60,7 +62,9 @@ pub use cylinder::{
     expand, hold_pressures, Cylinder, CylinderPorts, EndStopSpec, InitialPressures, ValveSpec,
 };
 pub use end_stop::EndStop;
+pub use friction::{Friction, FrictionLaw};
 pub use leakage::Leakage;
+pub use machine::{Machine, Role};
 pub use orifice::{alpha, reg_root, reg_root_derivative, Orifice};
 pub use piston::Piston;
 pub use valve::Valve;
