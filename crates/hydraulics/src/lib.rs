@@ -31,6 +31,10 @@
 //! - [`Leakage`] (`hydraulics.leakage`, `hydraulics.tank_leakage`): laminar R (eq. 82).
 //! - [`Orifice`] (`hydraulics.orifice`) and [`Valve`] (`hydraulics.valve`): eqs. 29–31 with
 //!   the square root regularised by [`reg_root`].
+//! - [`Machine`] (`hydraulics.pump`, `hydraulics.motor`): displacement machine, Q = D·ω,
+//!   T = D·Δp with leakage and friction losses; a pump may run at a set `speed`.
+//! - [`Friction`] (`hydraulics.friction`): regularised Coulomb + Stribeck + viscous
+//!   ([`FrictionLaw`], also the machines' friction torque).
 //!
 //! The spool's P-controller (eq. 83) and first-order lag are the core's `p_control` and
 //! `lag`; they read the cylinder length `<cylinder>_piston.l`.
