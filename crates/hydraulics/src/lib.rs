@@ -45,8 +45,8 @@
 //! [`hold_pressures`] is the static initialisation rule.
 //!
 //! ## Model files
-//! [`register`] adds every kind to a [`bg_model::Registry`]. `docs/hydraulics.md` documents
-//! each kind's law, parameters and units.
+//! [`KINDS`] lists every kind, each a [`bondgraph::KindDecl`] declared beside its law;
+//! `docs/hydraulics.md` documents each kind's law, parameters and units.
 //!
 //! [`BondGraph`]: bondgraph::BondGraph
 
@@ -63,17 +63,13 @@ pub mod valve;
 
 pub use chamber::{Chamber, Side};
 pub use cylinder::{
-    expand, hold_pressures, Cylinder, CylinderPorts, EndStopSpec, InitialPressures, ValveSpec,
+    hold_pressures, Cylinder, CylinderPorts, EndStopSpec, InitialPressures, ValveSpec,
 };
 pub use end_stop::EndStop;
 pub use friction::{Friction, FrictionLaw};
+pub use kinds::KINDS;
 pub use leakage::Leakage;
 pub use machine::{Machine, Role};
 pub use orifice::{alpha, reg_root, reg_root_derivative, Orifice};
 pub use piston::Piston;
 pub use valve::Valve;
-
-/// Register every `hydraulics.*` element kind (and the `hydraulics.cylinder` composite).
-pub fn register(registry: &mut bg_model::Registry) {
-    kinds::register(registry);
-}
