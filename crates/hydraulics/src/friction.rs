@@ -26,6 +26,7 @@
 //! invertible where the Stribeck curve falls. Bond it *from* the 1-junction of the moving
 //! body (its flow in is then the body's velocity).
 
+use bondgraph::kind::{BuildError, KindDecl, ParamDecl, Params};
 use bondgraph::{
     CausalRule, Element, Io, LocalJacobian, ParamError, PortCausality, PortSpec, Ports, Slot,
 };
@@ -135,6 +136,83 @@ impl Element for Friction {
         true
     }
 }
+
+/// A friction law from a model's parameters, under the keys `keys` =
+/// [Coulomb, breakaway, Stribeck velocity, regularisation velocity, viscous] (`f_c`, `f_s`,
+/// `v_s`, `v_tanh`, `b` for the element; `t_c`, `t_s`, `omega_s`, `omega_tanh`, `b` for a
+/// machine's friction torque). The breakaway level defaults to the Coulomb level; a
+/// breakaway level needs its Stribeck velocity.
+pub fn law_of(p: &dyn Params, keys: [&str; 5]) -> Result<FrictionLaw, BuildError> {
+    let [k_c, k_s, k_vs, k_vt, k_b] = keys;
+    let f_c = p.number(k_c)?;
+    let (f_s, v_s) = match p.optional(k_s)? {
+        Some(f_s) => match p.optional(k_vs)? {
+            Some(v_s) => (f_s, v_s),
+            None => {
+                return Err(BuildError::missing(
+                    k_vs,
+                    format!("a breakaway level `{k_s}` needs the Stribeck velocity `{k_vs}`"),
+                )
+                .hint(format!(
+                    "add `{k_vs} = …` (the speed over which the friction falls from `{k_s}` to `{k_c}`), or drop `{k_s}`"
+                )))
+            }
+        },
+        None => {
+            if p.has(k_vs) {
+                return Err(BuildError::conflict(
+                    k_vs,
+                    format!("`{k_vs}` without a breakaway level `{k_s}` has no effect"),
+                )
+                .hint(format!("add `{k_s} = …` or drop `{k_vs}`")));
+            }
+            (f_c, 1.0)
+        }
+    };
+    FrictionLaw::new(f_c, f_s, v_s, p.number(k_vt)?, p.number(k_b)?).map_err(|e| {
+        // name the model's key, not the law's
+        let ParamError::OutOfRange { param, .. } = &e else {
+            return e.into();
+        };
+        let i = ["f_c", "f_s", "v_s", "v_tanh", "b"]
+            .iter()
+            .position(|k| k == param)
+            .unwrap_or(4);
+        BuildError::invalid(keys[i], e.to_string().replace(param.as_str(), keys[i]))
+    })
+}
+
+/// Kind `hydraulics.friction`.
+pub const KIND: KindDecl = KindDecl::element(
+    "hydraulics.friction",
+    "friction on a velocity: F = (F_c + (F_s − F_c)·exp(−(v/v_s)²))·tanh(v/v_tanh) + b·v",
+    &[
+        ParamDecl::number("f_c", "", "Coulomb level (N, or N·m on a shaft)")
+            .non_negative()
+            .default(0.0),
+        ParamDecl::number("f_s", "", "breakaway level (N or N·m)")
+            .non_negative()
+            .optional("f_c: no Stribeck peak"),
+        ParamDecl::number("v_s", "", "Stribeck velocity (m/s or rad/s)")
+            .positive()
+            .optional("needed with f_s"),
+        ParamDecl::number(
+            "v_tanh",
+            "",
+            "regularisation velocity of sign(v) (m/s or rad/s)",
+        )
+        .positive()
+        .default(1e-3),
+        ParamDecl::number("b", "", "viscous coefficient (N·s/m or N·m·s/rad)")
+            .non_negative()
+            .default(0.0),
+    ],
+    |p| {
+        let law = law_of(p, ["f_c", "f_s", "v_s", "v_tanh", "b"])?;
+        Ok(Box::new(Friction::new(law)))
+    },
+)
+.example("f_c = 800, f_s = 1200, v_s = 0.01, v_tanh = 1e-4, b = 2000");
 
 #[cfg(test)]
 mod tests {

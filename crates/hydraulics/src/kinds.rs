@@ -3,7 +3,7 @@
 
 use bondgraph::KindDecl;
 
-use crate::{chamber, cylinder, end_stop, leakage, orifice, piston, valve};
+use crate::{chamber, cylinder, end_stop, friction, leakage, machine, orifice, piston, valve};
 
 /// Every kind of this crate.
 pub const KINDS: &[KindDecl] = &[
@@ -15,4 +15,7 @@ pub const KINDS: &[KindDecl] = &[
     orifice::KIND,
     valve::KIND,
     cylinder::KIND,
+    machine::PUMP,
+    machine::MOTOR,
+    friction::KIND,
 ];

@@ -55,12 +55,13 @@
 //! `Q = D·ω − C_l·Δp` with ports `a`, `b`, and it publishes the torque the drive must
 //! apply as the signal `torque` (N·m), so the drive power is `torque·ω`.
 
+use bondgraph::kind::{BuildError, KindDecl, ParamDecl, Params, Range};
 use bondgraph::{
     CausalRule, Element, Io, LocalJacobian, Param, ParamError, PortCausality, PortSpec, Ports,
     SignalSpec, Slot, Stage,
 };
 
-use crate::friction::FrictionLaw;
+use crate::friction::{law_of, FrictionLaw};
 
 /// Which convention the shaft follows: a pump takes power in at its shaft, a motor gives it out.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -313,6 +314,106 @@ impl Element for Machine {
         true
     }
 }
+
+const DISPLACEMENT: ParamDecl = ParamDecl::number(
+    "displacement",
+    "m³/rad",
+    "displacement D_max at full stroke (\"40 cc/rev\" is read as 40e-6/(2π))",
+)
+.positive();
+const FRACTION: ParamDecl = ParamDecl::modulated(
+    "fraction",
+    "1",
+    "displacement fraction ε, D = ε·D_max (modulated: a variable machine; clamped to [−1, 1])",
+)
+.range(Range::closed(-1.0, 1.0))
+.default(1.0);
+const C_L: ParamDecl = ParamDecl::number(
+    "c_l",
+    "m³/(s·Pa)",
+    "laminar leakage coefficient, Q_leak = C_l·Δp",
+)
+.non_negative()
+.default(0.0);
+const T_C: ParamDecl = ParamDecl::number("t_c", "N·m", "Coulomb friction torque")
+    .non_negative()
+    .default(0.0);
+const T_S: ParamDecl = ParamDecl::number("t_s", "N·m", "breakaway friction torque")
+    .non_negative()
+    .optional("t_c: no Stribeck peak");
+const OMEGA_S: ParamDecl = ParamDecl::number("omega_s", "rad/s", "Stribeck speed")
+    .positive()
+    .optional("needed with t_s");
+const OMEGA_TANH: ParamDecl = ParamDecl::number(
+    "omega_tanh",
+    "rad/s",
+    "regularisation speed of the Coulomb torque's sign(ω)",
+)
+.positive()
+.default(0.1);
+const B: ParamDecl = ParamDecl::number("b", "N·m·s/rad", "viscous friction coefficient")
+    .non_negative()
+    .default(0.0);
+
+/// The machine of `role` from a model's parameters (`speed` only for the pump).
+fn build(p: &dyn Params, role: Role) -> Result<Machine, BuildError> {
+    let d = p.number("displacement")?;
+    let speed = if role == Role::Pump && p.has("speed") {
+        Some(p.modulated("speed")?)
+    } else {
+        None
+    };
+    let m = match speed {
+        Some(w) => Machine::pump_at_speed(d, w)?,
+        None => Machine::new(role, d)?,
+    };
+    let friction = law_of(p, ["t_c", "t_s", "omega_s", "omega_tanh", "b"])?;
+    Ok(m.with_fraction(p.modulated("fraction")?)?
+        .with_leakage(p.number("c_l")?)?
+        .with_friction(friction))
+}
+
+/// Kind `hydraulics.pump`.
+pub const PUMP: KindDecl = KindDecl::element(
+    "hydraulics.pump",
+    "displacement pump a → b: Q = D·ω − C_l·Δp, T = D·Δp + T_f(ω); port shaft (ω in), or `speed` (no shaft; publishes torque)",
+    &[
+        DISPLACEMENT,
+        FRACTION,
+        C_L,
+        T_C,
+        T_S,
+        OMEGA_S,
+        OMEGA_TANH,
+        B,
+        ParamDecl::modulated(
+            "speed",
+            "rad/s",
+            "shaft speed ω: the pump is a flow source with no shaft port",
+        )
+        .optional("a shaft port, driven by the model"),
+    ],
+    |p| Ok(Box::new(build(p, Role::Pump)?)),
+)
+.example("displacement = 6.4e-6, c_l = 1e-12, t_c = 1.5, b = 3e-3");
+
+/// Kind `hydraulics.motor`.
+pub const MOTOR: KindDecl = KindDecl::element(
+    "hydraulics.motor",
+    "displacement motor a → b: Q = D·ω + C_l·Δp, T = D·Δp − T_f(ω) delivered at shaft (ω out)",
+    &[
+        DISPLACEMENT,
+        FRACTION,
+        C_L,
+        T_C,
+        T_S,
+        OMEGA_S,
+        OMEGA_TANH,
+        B,
+    ],
+    |p| Ok(Box::new(build(p, Role::Motor)?)),
+)
+.example("displacement = 8e-6, c_l = 1.5e-12, t_c = 2, b = 5e-3");
 
 #[cfg(test)]
 mod tests {
