@@ -3,7 +3,9 @@
 
 use bondgraph::KindDecl;
 
-use crate::{chamber, cylinder, end_stop, friction, leakage, machine, orifice, piston, valve};
+use crate::{
+    chamber, cylinder, end_stop, friction, laminar, leakage, machine, orifice, piston, valve,
+};
 
 /// Every kind of this crate.
 pub const KINDS: &[KindDecl] = &[
@@ -15,6 +17,7 @@ pub const KINDS: &[KindDecl] = &[
     orifice::KIND,
     valve::KIND,
     cylinder::KIND,
+    laminar::KIND,
     machine::PUMP,
     machine::MOTOR,
     friction::KIND,

@@ -29,6 +29,7 @@
 //! - [`Piston`] (`hydraulics.piston`): the TF pair A_p, A_r (eqs. 80–81) and the stroke.
 //! - [`EndStop`] (`hydraulics.end_stop`): stiff spring–damper past the stroke ends.
 //! - [`Leakage`] (`hydraulics.leakage`, `hydraulics.tank_leakage`): laminar R (eq. 82).
+//! - [`Laminar`] (`hydraulics.laminar`): a pipe's laminar resistance (Hagen–Poiseuille).
 //! - [`Orifice`] (`hydraulics.orifice`) and [`Valve`] (`hydraulics.valve`): eqs. 29–31 with
 //!   the square root regularised by [`reg_root`].
 //! - [`Machine`] (`hydraulics.pump`, `hydraulics.motor`): displacement machine, Q = D·ω,
@@ -55,6 +56,7 @@ pub mod cylinder;
 pub mod end_stop;
 pub mod friction;
 pub mod kinds;
+pub mod laminar;
 pub mod leakage;
 pub mod machine;
 pub mod orifice;
@@ -68,6 +70,7 @@ pub use cylinder::{
 pub use end_stop::EndStop;
 pub use friction::{Friction, FrictionLaw};
 pub use kinds::KINDS;
+pub use laminar::{pipe_resistance, Laminar};
 pub use leakage::Leakage;
 pub use machine::{Machine, Role};
 pub use orifice::{alpha, reg_root, reg_root_derivative, Orifice};
