@@ -4,7 +4,8 @@
 use bondgraph::KindDecl;
 
 use crate::{
-    accumulator, chamber, cylinder, end_stop, laminar, leakage, line, orifice, piston, tank, valve,
+    accumulator, chamber, cylinder, end_stop, friction, laminar, leakage, line, machine, orifice,
+    piston, tank, valve,
 };
 
 /// Every kind of this crate.
@@ -21,4 +22,7 @@ pub const KINDS: &[KindDecl] = &[
     accumulator::KIND,
     line::KIND,
     tank::KIND,
+    machine::PUMP,
+    machine::MOTOR,
+    friction::KIND,
 ];

@@ -32,7 +32,10 @@
 //! - [`Laminar`] (`hydraulics.laminar`): a pipe's laminar resistance (Hagen–Poiseuille).
 //! - [`Orifice`] (`hydraulics.orifice`) and [`Valve`] (`hydraulics.valve`): eqs. 29–31 with
 //!   the square root regularised by [`reg_root`].
-//!
+//! - [`Machine`] (`hydraulics.pump`, `hydraulics.motor`): displacement machine, Q = D·ω,
+//!   T = D·Δp with leakage and friction losses; a pump may run at a set `speed`.
+//! - [`Friction`] (`hydraulics.friction`): regularised Coulomb + Stribeck + viscous
+//!   ([`FrictionLaw`], also the machines' friction torque).
 //! - [`Accumulator`] (`hydraulics.accumulator`): gas-charged C, oil-volume state, polytropic
 //!   gas law, stiff oil below the precharge.
 //! - [`Line`] (`hydraulics.line`): N lumped C–R–I segments of a pipe or hose
@@ -59,10 +62,12 @@ pub mod chamber;
 pub mod cylinder;
 pub mod end_stop;
 pub mod fluid;
+pub mod friction;
 pub mod kinds;
 pub mod laminar;
 pub mod leakage;
 pub mod line;
+pub mod machine;
 pub mod orifice;
 pub mod piston;
 pub mod tank;
@@ -75,10 +80,12 @@ pub use cylinder::{
 };
 pub use end_stop::EndStop;
 pub use fluid::{Fluid, FluidOptions};
+pub use friction::{Friction, FrictionLaw};
 pub use kinds::KINDS;
 pub use laminar::{pipe_resistance, Laminar};
 pub use leakage::Leakage;
 pub use line::{Line, LineSpec, Wall};
+pub use machine::{Machine, Role};
 pub use orifice::{alpha, reg_root, reg_root_derivative, Orifice};
 pub use piston::Piston;
 pub use tank::Tank;
