@@ -53,6 +53,8 @@ pub mod kinds;
 pub mod leakage;
 pub mod orifice;
 pub mod piston;
+pub mod pressure_valve;
+pub mod ramp;
 pub mod valve;
 
 pub use chamber::{Chamber, Side};
@@ -63,6 +65,8 @@ pub use end_stop::EndStop;
 pub use leakage::Leakage;
 pub use orifice::{alpha, reg_root, reg_root_derivative, Orifice};
 pub use piston::Piston;
+pub use pressure_valve::{Opening, PressureValve};
+pub use ramp::ramp;
 pub use valve::Valve;
 
 /// Register every `hydraulics.*` element kind (and the `hydraulics.cylinder` composite).
