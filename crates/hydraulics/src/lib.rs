@@ -55,6 +55,7 @@ pub mod orifice;
 pub mod piston;
 pub mod pressure_valve;
 pub mod ramp;
+pub mod relief_valve;
 pub mod valve;
 
 pub use chamber::{Chamber, Side};
@@ -67,6 +68,7 @@ pub use orifice::{alpha, reg_root, reg_root_derivative, Orifice};
 pub use piston::Piston;
 pub use pressure_valve::{Opening, PressureValve};
 pub use ramp::ramp;
+pub use relief_valve::ReliefValve;
 pub use valve::Valve;
 
 /// Register every `hydraulics.*` element kind (and the `hydraulics.cylinder` composite).
