@@ -47,6 +47,7 @@
 //! [`BondGraph`]: bondgraph::BondGraph
 
 pub mod chamber;
+pub mod check_valve;
 pub mod cylinder;
 pub mod end_stop;
 pub mod kinds;
@@ -59,6 +60,7 @@ pub mod relief_valve;
 pub mod valve;
 
 pub use chamber::{Chamber, Side};
+pub use check_valve::CheckValve;
 pub use cylinder::{
     expand, hold_pressures, Cylinder, CylinderPorts, EndStopSpec, InitialPressures, ValveSpec,
 };
