@@ -49,6 +49,7 @@
 pub mod chamber;
 pub mod check_valve;
 pub mod cylinder;
+pub mod directional_valve;
 pub mod end_stop;
 pub mod kinds;
 pub mod leakage;
@@ -64,6 +65,7 @@ pub use check_valve::CheckValve;
 pub use cylinder::{
     expand, hold_pressures, Cylinder, CylinderPorts, EndStopSpec, InitialPressures, ValveSpec,
 };
+pub use directional_valve::{Centre, DirectionalValve};
 pub use end_stop::EndStop;
 pub use leakage::Leakage;
 pub use orifice::{alpha, reg_root, reg_root_derivative, Orifice};
