@@ -48,20 +48,25 @@
 
 pub mod chamber;
 pub mod check_valve;
+pub mod counterbalance_valve;
 pub mod cylinder;
 pub mod directional_valve;
 pub mod end_stop;
 pub mod kinds;
 pub mod leakage;
 pub mod orifice;
+pub mod pilot_check_valve;
 pub mod piston;
+pub mod pressure_reducing_valve;
 pub mod pressure_valve;
 pub mod ramp;
 pub mod relief_valve;
+pub mod sequence_valve;
 pub mod valve;
 
 pub use chamber::{Chamber, Side};
 pub use check_valve::CheckValve;
+pub use counterbalance_valve::CounterbalanceValve;
 pub use cylinder::{
     expand, hold_pressures, Cylinder, CylinderPorts, EndStopSpec, InitialPressures, ValveSpec,
 };
@@ -69,10 +74,13 @@ pub use directional_valve::{Centre, DirectionalValve};
 pub use end_stop::EndStop;
 pub use leakage::Leakage;
 pub use orifice::{alpha, reg_root, reg_root_derivative, Orifice};
+pub use pilot_check_valve::PilotCheckValve;
 pub use piston::Piston;
+pub use pressure_reducing_valve::PressureReducingValve;
 pub use pressure_valve::{Opening, PressureValve};
 pub use ramp::ramp;
 pub use relief_valve::ReliefValve;
+pub use sequence_valve::SequenceValve;
 pub use valve::Valve;
 
 /// Register every `hydraulics.*` element kind (and the `hydraulics.cylinder` composite).
