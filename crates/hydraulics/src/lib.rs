@@ -52,6 +52,7 @@ pub mod counterbalance_valve;
 pub mod cylinder;
 pub mod directional_valve;
 pub mod end_stop;
+pub mod flow_control_valve;
 pub mod kinds;
 pub mod leakage;
 pub mod orifice;
@@ -63,6 +64,8 @@ pub mod ramp;
 pub mod relief_valve;
 pub mod sequence_valve;
 pub mod valve;
+pub mod valve_2_2;
+pub mod valve_3_2;
 
 pub use chamber::{Chamber, Side};
 pub use check_valve::CheckValve;
@@ -72,6 +75,7 @@ pub use cylinder::{
 };
 pub use directional_valve::{Centre, DirectionalValve};
 pub use end_stop::EndStop;
+pub use flow_control_valve::FlowControlValve;
 pub use leakage::Leakage;
 pub use orifice::{alpha, reg_root, reg_root_derivative, Orifice};
 pub use pilot_check_valve::PilotCheckValve;
@@ -82,6 +86,8 @@ pub use ramp::ramp;
 pub use relief_valve::ReliefValve;
 pub use sequence_valve::SequenceValve;
 pub use valve::Valve;
+pub use valve_2_2::Valve22;
+pub use valve_3_2::Valve32;
 
 /// Register every `hydraulics.*` element kind (and the `hydraulics.cylinder` composite).
 pub fn register(registry: &mut bg_model::Registry) {
