@@ -108,8 +108,8 @@ pub struct DirectionalValve {
 }
 
 impl DirectionalValve {
-    /// A closed-centre, zero-lap valve with coefficient `alpha` and spool `x_v`, no leakage,
-    /// p_tr = 1e5 Pa; set the rest with the `with_*` methods.
+    /// A closed-centre, zero-lap valve with coefficient `alpha` and spool `x_v`, edge leakage
+    /// 1e-13 m³/(s·Pa), p_tr = 1e5 Pa; set the rest with the `with_*` methods.
     pub fn new(alpha: f64, x_v: impl Into<Param>) -> Result<Self, ParamError> {
         ParamError::positive("alpha", alpha)?;
         let x_v = x_v.into();
@@ -123,7 +123,7 @@ impl DirectionalValve {
             centre: Centre::Closed,
             centre_area: 1.0,
             centre_stroke: 0.2,
-            g_leak: 0.0,
+            g_leak: 1e-13,
             p_tr: 1e5,
         })
     }

@@ -64,7 +64,7 @@ pub fn register(r: &mut Registry) {
     );
 }
 
-fn boxed<E: Element + 'static>(s: &ElementSpec<'_>, e: Result<E, ParamError>) -> Built {
+pub(crate) fn boxed<E: Element + 'static>(s: &ElementSpec<'_>, e: Result<E, ParamError>) -> Built {
     e.map(|e| Box::new(e) as _).map_err(|e| s.param_error(&e))
 }
 
@@ -76,7 +76,7 @@ fn optional(s: &ElementSpec<'_>, key: &str) -> Result<Option<f64>, ModelError> {
     }
 }
 
-fn boolean(s: &ElementSpec<'_>, key: &str, default: bool) -> Result<bool, ModelError> {
+pub(crate) fn boolean(s: &ElementSpec<'_>, key: &str, default: bool) -> Result<bool, ModelError> {
     match s.raw(key) {
         None => Ok(default),
         Some(toml::Value::Boolean(b)) => Ok(*b),
@@ -89,7 +89,7 @@ fn boolean(s: &ElementSpec<'_>, key: &str, default: bool) -> Result<bool, ModelE
 }
 
 /// α from `alpha`, or from `cd`, `w` and `rho` (eq. 31).
-fn alpha(s: &ElementSpec<'_>) -> Result<f64, ModelError> {
+pub(crate) fn alpha(s: &ElementSpec<'_>) -> Result<f64, ModelError> {
     if s.has("alpha") {
         for k in ["cd", "w", "rho"] {
             if s.has(k) {

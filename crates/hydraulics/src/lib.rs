@@ -66,6 +66,7 @@ pub mod sequence_valve;
 pub mod valve;
 pub mod valve_2_2;
 pub mod valve_3_2;
+pub mod valve_kinds;
 
 pub use chamber::{Chamber, Side};
 pub use check_valve::CheckValve;
@@ -92,4 +93,5 @@ pub use valve_3_2::Valve32;
 /// Register every `hydraulics.*` element kind (and the `hydraulics.cylinder` composite).
 pub fn register(registry: &mut bg_model::Registry) {
     kinds::register(registry);
+    valve_kinds::register(registry);
 }
