@@ -188,9 +188,11 @@ impl DirectionalValve {
             0.0
         };
         let width = 1.0 - self.lap;
+        // At a kink the slope is one-sided: at ξ = 0 the P→A side takes its opening slope and
+        // the P→B side none, so at x_v = lap = 0 the partials are the right derivative.
         let side = |s: f64| {
             let xi = (s * x - self.lap) / width;
-            if xi <= 0.0 {
+            if xi < 0.0 || (xi == 0.0 && s < 0.0) {
                 (0.0, 0.0)
             } else if xi >= 1.0 {
                 (1.0, 0.0)
