@@ -135,7 +135,7 @@ impl DirectionalValve {
                 return Err(ParamError::OutOfRange {
                     param: name.into(),
                     value: v,
-                    requirement: "a fraction of the stroke in [0, 1)".into(),
+                    requirement: "a fraction of the stroke in [0, 1)",
                 });
             }
         }
@@ -162,7 +162,7 @@ impl DirectionalValve {
             return Err(ParamError::OutOfRange {
                 param: "centre_stroke".into(),
                 value: stroke,
-                requirement: "in (0, 1]".into(),
+                requirement: "in (0, 1]",
             });
         }
         self.centre = centre;
@@ -338,6 +338,7 @@ impl Element for DirectionalValve {
 }
 
 #[cfg(test)]
+#[allow(clippy::float_cmp)] // exact zeros and copied flows are meant exactly
 mod tests {
     use super::*;
 

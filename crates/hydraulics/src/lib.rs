@@ -35,6 +35,20 @@
 //! The spool's P-controller (eq. 83) and first-order lag are the core's `p_control` and
 //! `lag`; they read the cylinder length `<cylinder>_piston.l`.
 //!
+//! ## Valves (any supply: every port is hydraulic; `docs/hydraulics.md`, "Valves")
+//! Each opening passes oil as an orifice, `α·x·regRoot(Δp)`, with a laminar leak; every valve
+//! conserves volume and only dissipates.
+//! - Pressure-operated, on the shared law of [`PressureValve`] with the C¹ opening [`ramp`]:
+//!   [`ReliefValve`] (`hydraulics.relief_valve`, optional poppet lag), [`CheckValve`]
+//!   (`hydraulics.check_valve`), [`PilotCheckValve`] (`hydraulics.pilot_check_valve`),
+//!   [`CounterbalanceValve`] (`hydraulics.counterbalance_valve`), [`SequenceValve`]
+//!   (`hydraulics.sequence_valve`), [`PressureReducingValve`]
+//!   (`hydraulics.pressure_reducing_valve`).
+//! - Spool-operated: [`DirectionalValve`] (`hydraulics.directional_valve`: 4/3, ports P, T,
+//!   A, B, [`Centre`] closed/open/tandem/float, overlap/underlap), [`Valve22`]
+//!   (`hydraulics.valve_2_2`), [`Valve32`] (`hydraulics.valve_3_2`).
+//! - [`FlowControlValve`] (`hydraulics.flow_control_valve`): pressure-compensated.
+//!
 //! ## The cylinder as one component
 //! [`Cylinder`] (`hydraulics.cylinder`) assembles chambers, piston, leakage, valve and end
 //! stop; [`Cylinder::composite`] for model files, [`Cylinder::add_to`] for a [`BondGraph`].

@@ -103,7 +103,7 @@ impl PressureValve {
                 return Err(ParamError::OutOfRange {
                     param: "smoothing".into(),
                     value: o.eps,
-                    requirement: "between 0 and 0.5".into(),
+                    requirement: "between 0 and 0.5",
                 });
             }
         }

@@ -150,6 +150,7 @@ impl Element for Valve32 {
 }
 
 #[cfg(test)]
+#[allow(clippy::float_cmp)] // exact zeros and copied flows are meant exactly
 mod tests {
     use super::*;
 
