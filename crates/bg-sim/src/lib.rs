@@ -8,6 +8,7 @@
 use bg_model::Registry;
 
 pub mod bench;
+pub mod kinds;
 pub mod modes;
 pub mod plot;
 pub mod reduce;
@@ -17,7 +18,7 @@ pub mod sweep;
 #[must_use]
 pub fn registry() -> Registry {
     let mut r = Registry::with_core();
-    bg_hydraulics::register(&mut r);
-    bg_manipulator::register(&mut r);
+    r.add(bg_hydraulics::KINDS);
+    r.add(bg_manipulator::KINDS);
     r
 }

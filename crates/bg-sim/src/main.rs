@@ -140,8 +140,12 @@ enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
     },
-    /// List the element kinds a model file can use.
-    Kinds,
+    /// List the element kinds a model file can use, or describe one: its ports, parameters
+    /// (units, defaults, ranges), states and published signals.
+    Kinds {
+        /// A kind to describe in full (`hydraulics.chamber`).
+        name: Option<String>,
+    },
     /// The model's time scales: linearise at the initial state (or at time T of a run) and
     /// list every eigenvalue as frequency, damping ratio and time constant with the states
     /// that take part in it, the stiffness ratio and what it means for the solver.
@@ -280,7 +284,10 @@ fn main() -> ExitCode {
     // For these commands the report on stdout is the product: losing it is a failure.
     let stdout_is_product = matches!(
         cli.command,
-        Command::Kinds | Command::Check { .. } | Command::Compare { .. } | Command::Modes { .. }
+        Command::Kinds { .. }
+            | Command::Check { .. }
+            | Command::Compare { .. }
+            | Command::Modes { .. }
     );
     let code = dispatch(cli.command);
     let lost = STDOUT_ERROR.lock().ok().and_then(|e| *e);
@@ -362,12 +369,20 @@ fn dispatch(command: Command) -> ExitCode {
             jobs,
             output,
         } => sweep(&model, &spec, jobs, output),
-        Command::Kinds => {
-            for (k, info) in registry().kinds() {
-                say!("{k:<24} {}", info.summary);
-            }
+        Command::Kinds { name: None } => {
+            say!("{}", bg_sim::kinds::list(&registry()).trim_end());
             ExitCode::SUCCESS
         }
+        Command::Kinds { name: Some(name) } => match bg_sim::kinds::report(&registry(), &name) {
+            Ok(text) => {
+                say!("{}", text.trim_end());
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                ExitCode::from(2)
+            }
+        },
         Command::Plot { results, out } => plot(&results, &out, false),
         Command::Compare {
             results,

@@ -28,6 +28,23 @@ pub enum ParamError {
 }
 
 impl ParamError {
+    /// `param` = `value` is not `requirement` ("finite and > 0").
+    #[must_use]
+    pub fn invalid(param: &str, value: f64, requirement: &'static str) -> Self {
+        Self::OutOfRange {
+            param: param.to_owned(),
+            value,
+            requirement,
+        }
+    }
+    /// Lengths, indices or shapes of `param` that do not fit together.
+    #[must_use]
+    pub fn shape(param: &str, message: impl Into<String>) -> Self {
+        Self::Shape {
+            param: param.to_owned(),
+            message: message.into(),
+        }
+    }
     /// Check `value` is finite and `> 0`.
     pub fn positive(param: &str, value: f64) -> Result<f64, Self> {
         if value.is_finite() && value > 0.0 {

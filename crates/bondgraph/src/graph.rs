@@ -255,6 +255,24 @@ impl BondGraph {
         self.connect((f, None), (t, None))
     }
 
+    /// Connect ends written as `element` or `element.port` (a model file's `"a.p -> b"`)
+    /// with a bond called `name`.
+    pub fn connect_ends(&mut self, name: &str, from: &str, to: &str) -> Result<BondId, GraphError> {
+        let f = self.end(from)?;
+        let t = self.end(to)?;
+        self.connect_named(name, f, t)
+    }
+
+    /// An end `element` or `element.port` as (element id, port index).
+    fn end(&self, s: &str) -> Result<(ElementId, Option<usize>), GraphError> {
+        let (el, port) = s.split_once('.').map_or((s, None), |(e, p)| (e, Some(p)));
+        let id = self.find(el).ok_or_else(|| GraphError::UnknownElement {
+            name: el.to_owned(),
+        })?;
+        let port = port.map(|p| self.port_index(id, p)).transpose()?;
+        Ok((id, port))
+    }
+
     /// Replace element `id` by one of the same kind, ports and states (a parameter switch).
     pub fn replace(
         &mut self,

@@ -34,6 +34,12 @@
 //! Other crates add kinds by implementing [`Element`]; modulation goes through named signals
 //! ([`Param`], [`Element::signal_inputs`]).
 //!
+//! ## Element kinds
+//! [`kind`] declares what a model file may write for each element kind: its parameters as data
+//! ([`ParamDecl`]: name, unit, default, range, description), its builder reading them through
+//! [`Params`], and [`Composite`]s — sub-graphs with exposed ports and the one naming rule of
+//! their members.
+//!
 //! ## Causality
 //! [`assign_causality`] runs SCAP and returns a [`CausalGraph`], or refuses derivative
 //! causality and causal conflicts with a [`CausalityError`] naming the elements and bonds.
@@ -64,6 +70,8 @@ pub mod equations;
 pub mod equilibrium;
 pub mod error;
 pub mod graph;
+pub mod kind;
+pub mod kinds;
 pub mod local_jacobian;
 pub mod modes;
 pub mod radau;
@@ -80,6 +88,7 @@ pub use equations::{Probe, StateEquations, StateInfo};
 pub use equilibrium::{solve_steady, Condition, Equilibrium, EquilibriumError, SteadyRequest};
 pub use error::{CausalityError, Error, GraphError, ParamError, SimulationError};
 pub use graph::{BondGraph, Node};
+pub use kind::{BuildError, Composite, KindDecl, ParamDecl, Params};
 pub use local_jacobian::{check_partials, LocalJacobian, LocalShape};
 pub use modes::{modes, modes_of, stiffness_ratio, Mode, ModesError};
 /// The dense matrix type of [`StateEquations::jacobian`].

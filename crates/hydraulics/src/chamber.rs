@@ -26,6 +26,7 @@
 //! more than 1e-6 of the nominal pressure (1 Pa by default): smaller undershoots are the
 //! solver's tolerance, not cavitation.
 
+use bondgraph::kind::{BuildError, KindDecl, ParamDecl, Params};
 use bondgraph::{
     CausalRule, Element, Io, LocalJacobian, Param, ParamError, PortCausality, PortSpec, Ports,
     SignalSpec, Slot, Stage, StateSpec, Watch,
@@ -219,6 +220,81 @@ impl Element for Chamber {
             warning: "cavitation, which the model does not represent".into(),
         }]
     }
+}
+
+/// Kind `hydraulics.chamber`.
+pub const KIND: KindDecl = KindDecl::element(
+    "hydraulics.chamber",
+    "oil volume, C with pressure state: dP/dt = β/V(s)·Q, V = A(l⁰ ± s) or fixed; publishes V",
+    &[
+        ParamDecl::choice(
+            "side",
+            &["piston", "rod"],
+            "piston",
+            "which side of the piston the chamber is on",
+        ),
+        ParamDecl::number("area", "m²", "piston or annulus area")
+            .positive()
+            .optional("give `volume` instead"),
+        ParamDecl::number("dead_length", "m", "chamber length at s = 0")
+            .non_negative()
+            .optional("give `volume` instead"),
+        ParamDecl::modulated("stroke", "m", "stroke signal, e.g. \"cyl.s\"")
+            .optional("give `volume` instead"),
+        ParamDecl::number(
+            "volume",
+            "m³",
+            "a fixed volume (hose, pipe) instead of area, dead_length, stroke",
+        )
+        .positive()
+        .optional("a cylinder chamber"),
+        ParamDecl::number("beta", "Pa", "bulk modulus β").positive(),
+        ParamDecl::number("p0", "Pa", "initial pressure").default(0.0),
+        ParamDecl::number("v_min", "m³", "smallest volume used")
+            .positive()
+            .optional("1e-3 of A·l⁰, or A·1 µm if l⁰ = 0"),
+        ParamDecl::number("p_tank", "Pa", "tank pressure for the cavitation warning").default(0.0),
+        ParamDecl::number("p_nominal", "Pa", "tolerance scale of the pressure state")
+            .positive()
+            .default(1e6),
+    ],
+    build,
+)
+.example("volume = 1e-3, beta = 1.5e9, p0 = 1e6");
+
+fn build(p: &dyn Params) -> Result<Box<dyn Element>, BuildError> {
+    let beta = p.number("beta")?;
+    let p0 = p.number("p0")?;
+    let c = if p.has("volume") {
+        for k in ["area", "dead_length", "stroke", "side"] {
+            if p.has(k) {
+                return Err(BuildError::conflict(k, format!("give either `volume` or `area`, `dead_length` and `stroke`, not `{k}` with `volume`")));
+            }
+        }
+        Chamber::fixed(p.number("volume")?, beta, p0)
+    } else {
+        let side = if p.word("side")? == "rod" {
+            Side::Rod
+        } else {
+            Side::Piston
+        };
+        Chamber::cylinder(
+            side,
+            p.number("area")?,
+            p.number("dead_length")?,
+            beta,
+            p.modulated("stroke")?,
+            p0,
+        )
+    };
+    let mut c = c?;
+    if let Some(v) = p.optional("v_min")? {
+        c = c.with_v_min(v)?;
+    }
+    let c = c
+        .with_tank_pressure(p.number("p_tank")?)?
+        .with_nominal_pressure(p.number("p_nominal")?)?;
+    Ok(Box::new(c))
 }
 
 #[cfg(test)]

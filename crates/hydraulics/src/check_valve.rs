@@ -17,6 +17,8 @@
 //! Causality: conductance (both ports receive their pressure, set their flow). Dissipates
 //! Q·Δp ≥ 0. Publishes the opening `x`.
 
+use crate::orifice;
+use bondgraph::kind::{KindDecl, ParamDecl, Range};
 use bondgraph::ParamError;
 
 use crate::pressure_valve::{Opening, PressureValve};
@@ -76,6 +78,51 @@ impl CheckValve {
         )
     }
 }
+
+/// Half-width ε of the rounded corners of the opening ([`crate::ramp`]).
+const SMOOTHING: ParamDecl = ParamDecl::number(
+    "smoothing",
+    "1",
+    "half-width ε of the opening's rounded corners, fraction of its pressure band",
+)
+.range(Range::closed(0.0, 0.5))
+.default(0.05);
+/// The seat's leak.
+const G_LEAK: ParamDecl =
+    ParamDecl::number("g_leak", "m³/(s·Pa)", "leak conductance of the closed seat")
+        .non_negative()
+        .default(1e-15);
+
+/// Kind `hydraulics.check_valve`.
+pub const KIND: KindDecl = KindDecl::element(
+    "hydraulics.check_valve",
+    "check valve in → out: x = ramp((Δp − p_crack)/dp_open), Q = α·x·regRoot(Δp) + g_leak·Δp",
+    &[
+        orifice::ALPHA,
+        orifice::CD,
+        orifice::W,
+        orifice::RHO,
+        ParamDecl::number("p_crack", "Pa", "cracking pressure")
+            .non_negative()
+            .default(1e5),
+        ParamDecl::number("dp_open", "Pa", "pressure rise from cracking to fully open")
+            .positive()
+            .default(2e5),
+        SMOOTHING,
+        G_LEAK,
+        orifice::P_TR,
+    ],
+    |p| {
+        let mut v = CheckValve::new(orifice::alpha_of(p)?);
+        v.p_crack = p.number("p_crack")?;
+        v.dp_open = p.number("dp_open")?;
+        v.smoothing = p.number("smoothing")?;
+        v.g_leak = p.number("g_leak")?;
+        v.p_tr = p.number("p_tr")?;
+        Ok(Box::new(v.build()?))
+    },
+)
+.example("alpha = 1e-6");
 
 #[cfg(test)]
 mod tests {

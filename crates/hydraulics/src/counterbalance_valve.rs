@@ -23,6 +23,8 @@
 //! The pilot port `X` only senses its pressure (no flow). Causality: conductance at all three
 //! ports. Dissipates Q·(P_V − P_C) ≥ 0. Publishes the openings `x` and `x_check`.
 
+use crate::orifice;
+use bondgraph::kind::{BuildError, KindDecl, ParamDecl, Params, Range};
 use bondgraph::ParamError;
 
 use crate::pressure_valve::{Opening, PressureValve};
@@ -109,6 +111,60 @@ impl CounterbalanceValve {
             None,
         )
     }
+}
+
+/// Half-width ε of the rounded corners of the opening ([`crate::ramp`]).
+const SMOOTHING: ParamDecl = ParamDecl::number(
+    "smoothing",
+    "1",
+    "half-width ε of the opening's rounded corners, fraction of its pressure band",
+)
+.range(Range::closed(0.0, 0.5))
+.default(0.05);
+/// The seat's leak.
+const G_LEAK: ParamDecl =
+    ParamDecl::number("g_leak", "m³/(s·Pa)", "leak conductance of the closed seat")
+        .non_negative()
+        .default(1e-15);
+
+/// Kind `hydraulics.counterbalance_valve`.
+pub const KIND: KindDecl = KindDecl::element(
+    "hydraulics.counterbalance_valve",
+    "counterbalance valve V, C, pilot X: opens C → V when P_C + ratio·P_X ≥ p_set; free flow V → C through a check",
+    &[
+        orifice::ALPHA,
+        orifice::CD,
+        orifice::W,
+        orifice::RHO,
+        ParamDecl::number("p_set", "Pa", "setting: the load pressure that opens it unpiloted").positive(),
+        ParamDecl::number("ratio", "1", "pilot ratio ψ").non_negative().default(3.0),
+        ParamDecl::number("dp_open", "Pa", "rise of the drive from cracking to fully open").positive().optional("0.1·p_set"),
+        ParamDecl::number("alpha_check", "m³/(s·√Pa)", "the check's orifice coefficient at full opening").positive().optional("alpha"),
+        ParamDecl::number("p_check", "Pa", "the check's cracking pressure").non_negative().default(1e5),
+        ParamDecl::number("dp_check", "Pa", "the check's rise from cracking to fully open").positive().default(2e5),
+        SMOOTHING,
+        G_LEAK,
+        orifice::P_TR,
+    ],
+    build,
+)
+.example("alpha = 6e-7, p_set = 1.1e7");
+
+fn build(p: &dyn Params) -> Result<Box<dyn bondgraph::Element>, BuildError> {
+    let mut v = CounterbalanceValve::new(orifice::alpha_of(p)?, p.number("p_set")?);
+    v.ratio = p.number("ratio")?;
+    if let Some(d) = p.optional("dp_open")? {
+        v.dp_open = d;
+    }
+    if let Some(a) = p.optional("alpha_check")? {
+        v.alpha_check = a;
+    }
+    v.p_check = p.number("p_check")?;
+    v.dp_check = p.number("dp_check")?;
+    v.smoothing = p.number("smoothing")?;
+    v.g_leak = p.number("g_leak")?;
+    v.p_tr = p.number("p_tr")?;
+    Ok(Box::new(v.build()?))
 }
 
 #[cfg(test)]

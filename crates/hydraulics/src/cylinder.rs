@@ -20,8 +20,10 @@
 //! Chamber pressures start from [`InitialPressures`]; [`hold_pressures`] is the scene's
 //! static initialisation rule.
 
-use bg_model::Composite;
-use bondgraph::{BondGraph, Error, GraphError, OneJunction, Param, ParamError, ZeroJunction};
+use bondgraph::kind::{member_name, BuildError, KindDecl, ParamDecl, Params};
+use bondgraph::{BondGraph, Composite, Error, OneJunction, Param, ParamError, ZeroJunction};
+
+use crate::orifice;
 
 use crate::{Chamber, EndStop, Leakage, Piston, Side, Valve};
 
@@ -225,7 +227,7 @@ impl Cylinder {
     /// called `instance` (signals inside refer to `<instance>_piston.s`).
     pub fn composite(self, instance: &str) -> Result<Composite, ParamError> {
         self.validate()?;
-        let stroke_signal = format!("{instance}_piston.s");
+        let stroke_signal = format!("{}.s", member_name(instance, "piston"));
         let stroke = || Param::modulated(vec![stroke_signal.clone()], |_, u| u[0]);
         let (p_p0, p_r0) = self.initial_pressures();
         let chamber = |side, area, l, p0| -> Result<Chamber, ParamError> {
@@ -292,9 +294,8 @@ impl Cylinder {
     /// Add the cylinder's members to `g` as `<name>_<member>` with their internal bonds;
     /// returns the elements to bond the exposed ports to.
     pub fn add_to(self, g: &mut BondGraph, name: &str) -> Result<CylinderPorts, Error> {
-        let c = self.composite(name)?;
-        expand(g, name, c)?;
-        let global = |l: &str| format!("{name}_{l}");
+        self.composite(name)?.add_to(name, g)?;
+        let global = |l: &str| member_name(name, l);
         Ok(CylinderPorts {
             mech: global("rod"),
             a: global("jp"),
@@ -304,25 +305,159 @@ impl Cylinder {
     }
 }
 
-/// Add a composite's members and internal bonds to `g` under `<name>_<local>` names.
-pub fn expand(g: &mut BondGraph, name: &str, c: Composite) -> Result<(), Error> {
-    let global = |l: &str| format!("{name}_{l}");
-    for (local, el) in c.elements {
-        g.add_boxed(&global(&local), el)?;
+/// Kind `hydraulics.cylinder`: the composite of this file (see the module documentation).
+pub const KIND: KindDecl = KindDecl::composite(
+    "hydraulics.cylinder",
+    "valve-controlled cylinder: chambers, piston, leakage, valve, end stop; ports mech, A, B",
+    &[
+        ParamDecl::number("a_p", "m²", "piston area").positive(),
+        ParamDecl::number("a_r", "m²", "annulus area").positive(),
+        ParamDecl::number(
+            "l_p0",
+            "m",
+            "piston-side chamber length at s = 0: V_p = A_p(l_p0 + s)",
+        )
+        .non_negative(),
+        ParamDecl::number(
+            "l_r0",
+            "m",
+            "rod-side chamber length at s = 0: V_r = A_r(l_r0 − s); l_r0 ≥ s_max",
+        )
+        .non_negative(),
+        ParamDecl::number("s_max", "m", "usable stroke").positive(),
+        ParamDecl::number("beta", "Pa", "bulk modulus").positive(),
+        ParamDecl::number("l0", "m", "length at s = 0").default(0.0),
+        ParamDecl::number(
+            "s0",
+            "m",
+            "initial stroke (within [0, s_max] unless there is an end stop)",
+        )
+        .default(0.0),
+        ParamDecl::number("v_min", "m³", "smallest chamber volume")
+            .positive()
+            .optional("1e-3 of each dead volume"),
+        ParamDecl::number("p_t", "Pa", "tank pressure").default(0.0),
+        ParamDecl::number(
+            "hold_force",
+            "N",
+            "force the initial pressures hold (static initialisation)",
+        )
+        .default(0.0),
+        ParamDecl::number(
+            "p_pre",
+            "Pa",
+            "pressure of the less loaded chamber in the static initialisation",
+        )
+        .default(1e6),
+        ParamDecl::number(
+            "p_p0",
+            "Pa",
+            "initial piston-side pressure, instead of hold_force",
+        )
+        .optional("from hold_force"),
+        ParamDecl::number(
+            "p_r0",
+            "Pa",
+            "initial rod-side pressure, instead of hold_force",
+        )
+        .optional("from hold_force"),
+        ParamDecl::modulated("x_v", "1", "spool stroke signal: includes the valve")
+            .optional("no valve: drive ports A and B"),
+        orifice::ALPHA,
+        orifice::CD,
+        orifice::W,
+        orifice::RHO,
+        ParamDecl::number("p_s", "Pa", "supply pressure (with the valve)").optional("no valve"),
+        orifice::P_TR,
+        ParamDecl::number("r_int", "Pa·s/m³", "internal leakage resistance")
+            .positive()
+            .optional("no internal leakage"),
+        ParamDecl::number(
+            "r_ext",
+            "Pa·s/m³",
+            "external leakage resistance of each chamber to tank",
+        )
+        .positive()
+        .optional("no external leakage"),
+        ParamDecl::number("k_stop", "N/m", "end-stop stiffness at s = 0 and s = s_max")
+            .positive()
+            .optional("no end stop: leaving the stroke stops the run"),
+        ParamDecl::number("c_stop", "N·s/m", "end-stop damping")
+            .non_negative()
+            .default(0.0),
+        ParamDecl::number("stop_width", "m", "end-stop contact width")
+            .positive()
+            .default(1e-5),
+    ],
+    build,
+)
+.example(
+    "a_p = 0.0045, a_r = 0.0025, l_p0 = 0.05, l_r0 = 0.55, s_max = 0.5, beta = 1.5e9, s0 = 0.1",
+);
+
+fn build(p: &dyn Params) -> Result<Composite, BuildError> {
+    let mut c = Cylinder::new(
+        p.number("a_p")?,
+        p.number("a_r")?,
+        p.number("l_p0")?,
+        p.number("l_r0")?,
+        p.number("s_max")?,
+        p.number("beta")?,
+    );
+    c.l0 = p.number("l0")?;
+    c.s0 = p.number("s0")?;
+    c.v_min = p.optional("v_min")?;
+    c.p_t = p.number("p_t")?;
+    c.r_int = p.optional("r_int")?;
+    c.r_ext = p.optional("r_ext")?;
+    c.initial = if p.has("p_p0") || p.has("p_r0") {
+        if let Some(k) = ["hold_force", "p_pre"].into_iter().find(|k| p.has(k)) {
+            return Err(BuildError::conflict(
+                k,
+                "give either `hold_force` (and `p_pre`) or `p_p0` and `p_r0`, not both",
+            ));
+        }
+        InitialPressures::Given {
+            p_p: p.number("p_p0")?,
+            p_r: p.number("p_r0")?,
+        }
+    } else {
+        InitialPressures::Hold {
+            force: p.number("hold_force")?,
+            p_pre: p.number("p_pre")?,
+        }
+    };
+    if p.has("x_v") {
+        c.valve = Some(ValveSpec {
+            alpha: orifice::alpha_of(p)?,
+            x_v: p.modulated("x_v")?,
+            p_s: p.number("p_s")?,
+            p_tr: p.number("p_tr")?,
+        });
+    } else if let Some(k) = ["alpha", "cd", "w", "rho", "p_s", "p_tr"]
+        .into_iter()
+        .find(|k| p.has(k))
+    {
+        // Valve parameters without a valve would be silently ignored: refuse them.
+        return Err(BuildError::conflict(
+            k,
+            format!("`{k}` is a valve parameter, but there is no valve"),
+        )
+        .hint("give the spool stroke `x_v = \"<signal>\"` to include the valve"));
     }
-    for (bond, from, to) in &c.bonds {
-        let end = |s: &str| -> Result<(usize, Option<usize>), GraphError> {
-            let (el, port) = s.split_once('.').map_or((s, None), |(e, p)| (e, Some(p)));
-            let id = g
-                .find(&global(el))
-                .ok_or_else(|| GraphError::UnknownElement { name: global(el) })?;
-            let port = port.map(|p| g.port_index(id, p)).transpose()?;
-            Ok((id, port))
-        };
-        let (f, t) = (end(from)?, end(to)?);
-        g.connect_named(&global(bond), f, t)?;
+    if p.has("k_stop") {
+        c.end_stop = Some(EndStopSpec {
+            k: p.number("k_stop")?,
+            c: p.number("c_stop")?,
+            width: p.number("stop_width")?,
+        });
+    } else if let Some(k) = ["c_stop", "stop_width"].into_iter().find(|k| p.has(k)) {
+        return Err(BuildError::conflict(
+            k,
+            format!("`{k}` needs an end stop: give `k_stop` too"),
+        ));
     }
-    Ok(())
+    Ok(c.composite(p.name())?)
 }
 
 #[cfg(test)]

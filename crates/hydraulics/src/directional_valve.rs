@@ -38,12 +38,13 @@
 //! Causality: every port receives its pressure and sets its flow (conductance): attach each to
 //! a 0-junction with a chamber (a hose volume) or to a pressure source.
 
+use bondgraph::kind::{BuildError, KindDecl, ParamDecl, Range};
 use bondgraph::{
     CausalRule, Element, Io, LocalJacobian, Param, ParamError, PortCausality, PortSpec, Ports,
     SignalSpec, Slot, Stage,
 };
 
-use crate::orifice::{reg_root, reg_root_derivative};
+use crate::orifice::{self, reg_root, reg_root_derivative};
 
 /// What the middle position connects (see the module documentation).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -336,6 +337,45 @@ impl Element for DirectionalValve {
         true
     }
 }
+
+/// A fraction of the stroke in [0, 1).
+const LAP: Range = Range {
+    hi_open: true,
+    ..Range::FRACTION
+};
+
+/// Kind `hydraulics.directional_valve`.
+pub const KIND: KindDecl = KindDecl::element(
+    "hydraulics.directional_valve",
+    "4/3 directional valve, ports P, T, A, B: four edges Q = α·o(x_v)·regRoot(Δp), centre closed/open/tandem/float, overlap/underlap",
+    &[
+        orifice::ALPHA,
+        orifice::CD,
+        orifice::W,
+        orifice::RHO,
+        ParamDecl::modulated("x_v", "1", "spool stroke, clamped to [−1, 1], e.g. \"spool.out\""),
+        ParamDecl::choice("centre", &["closed", "open", "tandem", "float"], "closed", "what the middle position connects"),
+        ParamDecl::number("centre_area", "1", "the centre passages' area, fraction of α").non_negative().default(1.0),
+        ParamDecl::number("centre_stroke", "1", "stroke at which the centre passages are shut")
+            .range(Range { lo_open: true, ..Range::FRACTION })
+            .default(0.2),
+        ParamDecl::number("overlap", "1", "dead band, fraction of the stroke").range(LAP).default(0.0),
+        ParamDecl::number("underlap", "1", "underlap, fraction of the stroke").range(LAP).default(0.0),
+        ParamDecl::number("g_leak", "m³/(s·Pa)", "leak conductance of each metering edge").non_negative().default(1e-13),
+        orifice::P_TR,
+    ],
+    |p| {
+        let word = p.word("centre")?;
+        let centre = Centre::from_word(&word)
+            .ok_or_else(|| BuildError::invalid("centre", format!("unknown centre \"{word}\"")))?;
+        let v = DirectionalValve::new(orifice::alpha_of(p)?, p.modulated("x_v")?)?
+            .with_lap(p.number("overlap")?, p.number("underlap")?)?
+            .with_centre(centre, p.number("centre_area")?, p.number("centre_stroke")?)?
+            .with_leakage(p.number("g_leak")?, p.number("p_tr")?)?;
+        Ok(Box::new(v))
+    },
+)
+.example("alpha = 6e-7, x_v = \"0.5*sin(t)\", centre = \"open\"");
 
 #[cfg(test)]
 #[allow(clippy::float_cmp)] // exact zeros and copied flows are meant exactly

@@ -17,6 +17,7 @@
 //! the flow, the stop the force). Bond it *from* the rod's 1-junction so that its flow in is
 //! the extension rate: on that junction the rod then delivers F_c − e.
 
+use bondgraph::kind::{KindDecl, ParamDecl};
 use bondgraph::{
     CausalRule, Element, Io, LocalJacobian, Param, ParamError, PortCausality, PortSpec, Ports,
     SignalSpec, Slot, Stage,
@@ -139,6 +140,42 @@ impl Element for EndStop {
         true
     }
 }
+
+/// Kind `hydraulics.end_stop`.
+pub const KIND: KindDecl = KindDecl::element(
+    "hydraulics.end_stop",
+    "stiff spring–damper past either end of the stroke",
+    &[
+        ParamDecl::modulated("stroke", "m", "stroke signal, e.g. \"cyl.s\""),
+        ParamDecl::number("s_min", "m", "lower end of the stroke").default(0.0),
+        ParamDecl::number("s_max", "m", "upper end of the stroke"),
+        ParamDecl::number("k", "N/m", "stiffness").positive(),
+        ParamDecl::number(
+            "c",
+            "N·s/m",
+            "damping; near 2√(k·m) for a well-damped landing",
+        )
+        .non_negative(),
+        ParamDecl::number(
+            "width",
+            "m",
+            "contact width δ, small against the resting penetration F/k",
+        )
+        .positive()
+        .default(1e-5),
+    ],
+    |p| {
+        Ok(Box::new(EndStop::new(
+            p.modulated("stroke")?,
+            p.number("s_min")?,
+            p.number("s_max")?,
+            p.number("k")?,
+            p.number("c")?,
+            p.number("width")?,
+        )?))
+    },
+)
+.example("stroke = \"t\", s_max = 0.5, k = 1e8, c = 1e5");
 
 #[cfg(test)]
 #[allow(clippy::float_cmp)] // exact zeros and copied parameters are meant exactly

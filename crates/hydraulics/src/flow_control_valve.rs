@@ -18,6 +18,7 @@
 //!
 //! Causality: conductance at both ports. Dissipates Q·Δp ≥ 0.
 
+use bondgraph::kind::{KindDecl, ParamDecl};
 use bondgraph::{
     CausalRule, Element, Io, LocalJacobian, Param, ParamError, PortCausality, PortSpec, Ports,
     SignalSpec, Slot, Stage,
@@ -143,6 +144,31 @@ impl Element for FlowControlValve {
         true
     }
 }
+
+/// Kind `hydraulics.flow_control_valve`.
+pub const KIND: KindDecl = KindDecl::element(
+    "hydraulics.flow_control_valve",
+    "pressure-compensated flow control P → A: Q = q_set once Δp ≥ dp_comp, the metering orifice below",
+    &[
+        ParamDecl::modulated("q_set", "m³/s", "set flow (negative acts as 0)"),
+        ParamDecl::number("dp_comp", "Pa", "compensator pressure Δp_c").positive(),
+        ParamDecl::number("smoothing", "1", "half-width ε of the rounded knee, fraction of dp_comp")
+            .range(bondgraph::kind::Range::closed(0.0, 0.5))
+            .default(0.05),
+        ParamDecl::number("g_leak", "m³/(s·Pa)", "leak conductance").non_negative().default(0.0),
+        crate::orifice::P_TR,
+    ],
+    |p| {
+        Ok(Box::new(FlowControlValve::new(
+            p.modulated("q_set")?,
+            p.number("dp_comp")?,
+            p.number("smoothing")?,
+            p.number("g_leak")?,
+            p.number("p_tr")?,
+        )?))
+    },
+)
+.example("q_set = 3e-4, dp_comp = 6e5");
 
 #[cfg(test)]
 #[allow(clippy::float_cmp)] // exact zeros and copied flows are meant exactly

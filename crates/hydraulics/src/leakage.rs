@@ -9,6 +9,7 @@
 //! (ΔP)²/R ≥ 0. Causality: conductance (the lines set the pressures, the leak its flow); the
 //! external leak also accepts resistance causality (P = P_T + R·Q).
 
+use bondgraph::kind::{KindDecl, ParamDecl};
 use bondgraph::{
     CausalRule, Element, Io, LocalJacobian, ParamError, PortCausality, PortSpec, Ports, Slot,
 };
@@ -93,6 +94,34 @@ impl Element for Leakage {
         true
     }
 }
+
+const R: ParamDecl = ParamDecl::number("r", "Pa·s/m³", "leakage resistance").positive();
+
+/// Kind `hydraulics.leakage`.
+pub const INTERNAL: KindDecl = KindDecl::element(
+    "hydraulics.leakage",
+    "internal leakage between ports a and b: Q = (P_a − P_b)/r",
+    &[R],
+    |p| Ok(Box::new(Leakage::internal(p.number("r")?)?)),
+)
+.example("r = 1e12");
+
+/// Kind `hydraulics.tank_leakage`.
+pub const TO_TANK: KindDecl = KindDecl::element(
+    "hydraulics.tank_leakage",
+    "external leakage to tank: Q = (P − p_tank)/r",
+    &[
+        R,
+        ParamDecl::number("p_tank", "Pa", "tank pressure").default(0.0),
+    ],
+    |p| {
+        Ok(Box::new(Leakage::to_tank(
+            p.number("r")?,
+            p.number("p_tank")?,
+        )?))
+    },
+)
+.example("r = 1e12");
 
 #[cfg(test)]
 mod tests {

@@ -55,8 +55,8 @@
 //! [`hold_pressures`] is the static initialisation rule.
 //!
 //! ## Model files
-//! [`register`] adds every kind to a [`bg_model::Registry`]. `docs/hydraulics.md` documents
-//! each kind's law, parameters and units.
+//! [`KINDS`] lists every kind, each a [`bondgraph::KindDecl`] declared beside its law;
+//! `docs/hydraulics.md` documents each kind's law, parameters and units.
 //!
 //! [`BondGraph`]: bondgraph::BondGraph
 
@@ -80,17 +80,17 @@ pub mod sequence_valve;
 pub mod valve;
 pub mod valve_2_2;
 pub mod valve_3_2;
-pub mod valve_kinds;
 
 pub use chamber::{Chamber, Side};
 pub use check_valve::CheckValve;
 pub use counterbalance_valve::CounterbalanceValve;
 pub use cylinder::{
-    expand, hold_pressures, Cylinder, CylinderPorts, EndStopSpec, InitialPressures, ValveSpec,
+    hold_pressures, Cylinder, CylinderPorts, EndStopSpec, InitialPressures, ValveSpec,
 };
 pub use directional_valve::{Centre, DirectionalValve};
 pub use end_stop::EndStop;
 pub use flow_control_valve::FlowControlValve;
+pub use kinds::KINDS;
 pub use leakage::Leakage;
 pub use orifice::{alpha, reg_root, reg_root_derivative, Orifice};
 pub use pilot_check_valve::PilotCheckValve;
@@ -103,9 +103,3 @@ pub use sequence_valve::SequenceValve;
 pub use valve::Valve;
 pub use valve_2_2::Valve22;
 pub use valve_3_2::Valve32;
-
-/// Register every `hydraulics.*` element kind (and the `hydraulics.cylinder` composite).
-pub fn register(registry: &mut bg_model::Registry) {
-    kinds::register(registry);
-    valve_kinds::register(registry);
-}

@@ -16,6 +16,7 @@
 //! attach each to a 0-junction, a chamber or a pressure source. Power `Q·(P_a − P_b)` is
 //! dissipated (≥ 0 for x ≥ 0).
 
+use bondgraph::kind::{BuildError, KindDecl, ParamDecl, Params};
 use bondgraph::{
     CausalRule, Element, Io, LocalJacobian, Param, ParamError, PortCausality, PortSpec, Ports,
     SignalSpec, Slot, Stage,
@@ -128,6 +129,81 @@ impl Element for Orifice {
         true
     }
 }
+
+/// `alpha`: the orifice coefficient, or …
+pub const ALPHA: ParamDecl = ParamDecl::number(
+    "alpha",
+    "m³/(s·√Pa)",
+    "orifice coefficient α at full opening",
+)
+.positive()
+.optional("from `cd`, `w`, `rho` (eq. 31)");
+/// … `cd`, `w`, `rho` for eq. 31.
+pub const CD: ParamDecl = ParamDecl::number("cd", "1", "discharge coefficient")
+    .positive()
+    .optional("give `alpha` instead");
+/// Opening area at full opening.
+pub const W: ParamDecl = ParamDecl::number("w", "m²", "orifice area at full opening")
+    .positive()
+    .optional("give `alpha` instead");
+/// Oil density.
+pub const RHO: ParamDecl = ParamDecl::number("rho", "kg/m³", "oil density")
+    .positive()
+    .optional("give `alpha` instead");
+/// Transition pressure of the regularised square root.
+pub const P_TR: ParamDecl = ParamDecl::number(
+    "p_tr",
+    "Pa",
+    "transition pressure of regRoot (0: the paper's law)",
+)
+.non_negative()
+.default(1e5);
+
+/// α from `alpha`, or from `cd`, `w` and `rho` (eq. 31).
+pub fn alpha_of(p: &dyn Params) -> Result<f64, BuildError> {
+    if p.has("alpha") {
+        if let Some(k) = ["cd", "w", "rho"].into_iter().find(|k| p.has(k)) {
+            return Err(BuildError::conflict(
+                k,
+                "give either `alpha` or `cd`, `w`, `rho`, not both",
+            ));
+        }
+        return p.number("alpha");
+    }
+    if !(p.has("cd") || p.has("w") || p.has("rho")) {
+        return Err(BuildError::missing(
+            "alpha",
+            "needs the orifice coefficient: `alpha`, or `cd`, `w` and `rho`",
+        )
+        .hint(format!(
+            "add e.g. `cd = 0.6, w = 0.0007, rho = 880.0` to `{}` (α = cd·w·√(2/rho))",
+            p.name()
+        )));
+    }
+    Ok(alpha(p.number("cd")?, p.number("w")?, p.number("rho")?)?)
+}
+
+/// Kind `hydraulics.orifice`.
+pub const KIND: KindDecl = KindDecl::element(
+    "hydraulics.orifice",
+    "orifice a → b: Q = α·x·regRoot(P_a − P_b)",
+    &[
+        ALPHA,
+        CD,
+        W,
+        RHO,
+        ParamDecl::modulated("opening", "1", "relative opening x (not clamped)").default(1.0),
+        P_TR,
+    ],
+    |p| {
+        Ok(Box::new(Orifice::new(
+            alpha_of(p)?,
+            p.modulated("opening")?,
+            p.number("p_tr")?,
+        )?))
+    },
+)
+.example("cd = 0.6, w = 1e-5, rho = 880");
 
 #[cfg(test)]
 mod tests {

@@ -17,6 +17,8 @@
 //! The pilot port only senses its pressure (no flow). Causality: conductance at all three
 //! ports. Dissipates Q·(P_in − P_out) ≥ 0. Publishes the opening `x`.
 
+use crate::orifice;
+use bondgraph::kind::{KindDecl, ParamDecl, Range};
 use bondgraph::ParamError;
 
 use crate::pressure_valve::{Opening, PressureValve};
@@ -80,6 +82,49 @@ impl PilotCheckValve {
         )
     }
 }
+
+/// Half-width ε of the rounded corners of the opening ([`crate::ramp`]).
+const SMOOTHING: ParamDecl = ParamDecl::number(
+    "smoothing",
+    "1",
+    "half-width ε of the opening's rounded corners, fraction of its pressure band",
+)
+.range(Range::closed(0.0, 0.5))
+.default(0.05);
+/// The seat's leak.
+const G_LEAK: ParamDecl =
+    ParamDecl::number("g_leak", "m³/(s·Pa)", "leak conductance of the closed seat")
+        .non_negative()
+        .default(1e-15);
+
+/// Kind `hydraulics.pilot_check_valve`.
+pub const KIND: KindDecl = KindDecl::element(
+    "hydraulics.pilot_check_valve",
+    "pilot-operated check in → out, pilot X: x = ramp((Δp + ratio·P_X − p_crack)/dp_open), Q = α·x·regRoot(Δp)",
+    &[
+        orifice::ALPHA,
+        orifice::CD,
+        orifice::W,
+        orifice::RHO,
+        ParamDecl::number("ratio", "1", "pilot ratio ψ (pilot piston over seat area)").positive().default(3.0),
+        ParamDecl::number("p_crack", "Pa", "cracking pressure").non_negative().default(1e5),
+        ParamDecl::number("dp_open", "Pa", "rise of the drive from cracking to fully open").positive().default(2e5),
+        SMOOTHING,
+        G_LEAK,
+        orifice::P_TR,
+    ],
+    |p| {
+        let mut v = PilotCheckValve::new(orifice::alpha_of(p)?);
+        v.ratio = p.number("ratio")?;
+        v.p_crack = p.number("p_crack")?;
+        v.dp_open = p.number("dp_open")?;
+        v.smoothing = p.number("smoothing")?;
+        v.g_leak = p.number("g_leak")?;
+        v.p_tr = p.number("p_tr")?;
+        Ok(Box::new(v.build()?))
+    },
+)
+.example("alpha = 1e-6, ratio = 4");
 
 #[cfg(test)]
 mod tests {

@@ -23,6 +23,7 @@
 //! its state `s`, the bound and the time. The rows before are kept. With an end stop
 //! (`guard = false`) the piston goes on past the ends and the stop pushes it back.
 
+use bondgraph::kind::{KindDecl, ParamDecl};
 use bondgraph::{
     CausalRule, Element, Io, Limit, LocalJacobian, ParamError, PortCausality, PortSpec, Ports,
     SignalSpec, Slot, Stage, StateSpec,
@@ -178,6 +179,31 @@ impl Element for Piston {
         }]
     }
 }
+
+/// Kind `hydraulics.piston`.
+pub const KIND: KindDecl = KindDecl::element(
+    "hydraulics.piston",
+    "cylinder piston, TF pair: F = A_p·P_p − A_r·P_r, Q_p = A_p·ṡ, Q_r = −A_r·ṡ; state s, publishes l",
+    &[
+        ParamDecl::number("a_p", "m²", "piston area").positive(),
+        ParamDecl::number("a_r", "m²", "annulus area").positive(),
+        ParamDecl::number("l0", "m", "length at s = 0; publishes l = l0 + s").default(0.0),
+        ParamDecl::number("s0", "m", "initial stroke").default(0.0),
+        ParamDecl::number("s_max", "m", "usable stroke").positive(),
+        ParamDecl::flag("guard", true, "stop the run outside [0, s_max] (false with an end stop)"),
+    ],
+    |p| {
+        Ok(Box::new(Piston::new(
+            p.number("a_p")?,
+            p.number("a_r")?,
+            p.number("l0")?,
+            p.number("s0")?,
+            p.number("s_max")?,
+            p.flag("guard")?,
+        )?))
+    },
+)
+.example("a_p = 0.0045, a_r = 0.0025, s_max = 0.5");
 
 #[cfg(test)]
 mod tests {

@@ -18,6 +18,8 @@
 //!
 //! Causality: conductance at both ports. Dissipates Q·(P_P − P_A) ≥ 0. Publishes `x`.
 
+use crate::orifice;
+use bondgraph::kind::{KindDecl, ParamDecl, Range};
 use bondgraph::ParamError;
 
 use crate::pressure_valve::{Opening, PressureValve};
@@ -79,6 +81,54 @@ impl PressureReducingValve {
         )
     }
 }
+
+/// Half-width ε of the rounded corners of the opening ([`crate::ramp`]).
+const SMOOTHING: ParamDecl = ParamDecl::number(
+    "smoothing",
+    "1",
+    "half-width ε of the opening's rounded corners, fraction of its pressure band",
+)
+.range(Range::closed(0.0, 0.5))
+.default(0.05);
+/// The seat's leak.
+const G_LEAK: ParamDecl =
+    ParamDecl::number("g_leak", "m³/(s·Pa)", "leak conductance of the closed seat")
+        .non_negative()
+        .default(1e-15);
+
+/// Kind `hydraulics.pressure_reducing_valve`.
+pub const KIND: KindDecl = KindDecl::element(
+    "hydraulics.pressure_reducing_valve",
+    "pressure-reducing valve P → A: x = ramp((p_set − P_A)/dp_band), Q = α·x·regRoot(P_P − P_A)",
+    &[
+        orifice::ALPHA,
+        orifice::CD,
+        orifice::W,
+        orifice::RHO,
+        ParamDecl::number("p_set", "Pa", "outlet pressure at which it shuts").positive(),
+        ParamDecl::number(
+            "dp_band",
+            "Pa",
+            "outlet pressure band from fully open to shut",
+        )
+        .positive()
+        .optional("0.1·p_set"),
+        SMOOTHING,
+        G_LEAK,
+        orifice::P_TR,
+    ],
+    |p| {
+        let mut v = PressureReducingValve::new(orifice::alpha_of(p)?, p.number("p_set")?);
+        if let Some(d) = p.optional("dp_band")? {
+            v.dp_band = d;
+        }
+        v.smoothing = p.number("smoothing")?;
+        v.g_leak = p.number("g_leak")?;
+        v.p_tr = p.number("p_tr")?;
+        Ok(Box::new(v.build()?))
+    },
+)
+.example("alpha = 1e-6, p_set = 5e6");
 
 #[cfg(test)]
 mod tests {

@@ -29,6 +29,8 @@
 //! to 0-junctions with a chamber, or to pressure sources). Dissipates Q·Δp ≥ 0. Publishes the
 //! opening `x`.
 
+use crate::orifice;
+use bondgraph::kind::{BuildError, KindDecl, ParamDecl, Params, Range};
 use bondgraph::ParamError;
 
 use crate::pressure_valve::{Opening, PressureValve};
@@ -91,6 +93,52 @@ impl ReliefValve {
             self.tau,
         )
     }
+}
+
+/// Half-width ε of the rounded corners of the opening ([`crate::ramp`]).
+const SMOOTHING: ParamDecl = ParamDecl::number(
+    "smoothing",
+    "1",
+    "half-width ε of the opening's rounded corners, fraction of its pressure band",
+)
+.range(Range::closed(0.0, 0.5))
+.default(0.05);
+/// The seat's leak.
+const G_LEAK: ParamDecl =
+    ParamDecl::number("g_leak", "m³/(s·Pa)", "leak conductance of the closed seat")
+        .non_negative()
+        .default(1e-15);
+
+/// Kind `hydraulics.relief_valve`.
+pub const KIND: KindDecl = KindDecl::element(
+    "hydraulics.relief_valve",
+    "relief valve P → T: x = ramp((Δp − p_crack)/dp_override), Q = α·x·regRoot(Δp) + g_leak·Δp; optional poppet lag tau",
+    &[
+        orifice::ALPHA,
+        orifice::CD,
+        orifice::W,
+        orifice::RHO,
+        ParamDecl::number("p_crack", "Pa", "cracking pressure").positive(),
+        ParamDecl::number("dp_override", "Pa", "pressure rise from cracking to fully open").positive().optional("0.1·p_crack"),
+        SMOOTHING,
+        G_LEAK,
+        orifice::P_TR,
+        ParamDecl::number("tau", "s", "poppet time constant").positive().optional("no dynamics"),
+    ],
+    build,
+)
+.example("alpha = 2e-7, p_crack = 1.6e7");
+
+fn build(p: &dyn Params) -> Result<Box<dyn bondgraph::Element>, BuildError> {
+    let mut v = ReliefValve::new(orifice::alpha_of(p)?, p.number("p_crack")?);
+    if let Some(d) = p.optional("dp_override")? {
+        v.dp_override = d;
+    }
+    v.smoothing = p.number("smoothing")?;
+    v.g_leak = p.number("g_leak")?;
+    v.p_tr = p.number("p_tr")?;
+    v.tau = p.optional("tau")?;
+    Ok(Box::new(v.build()?))
 }
 
 #[cfg(test)]

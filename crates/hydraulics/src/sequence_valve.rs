@@ -14,6 +14,8 @@
 //!
 //! Causality: conductance at both ports. Dissipates Q·(P_P − P_A) ≥ 0. Publishes `x`.
 
+use crate::orifice;
+use bondgraph::kind::{KindDecl, ParamDecl, Range};
 use bondgraph::ParamError;
 
 use crate::pressure_valve::{Opening, PressureValve};
@@ -74,6 +76,54 @@ impl SequenceValve {
         )
     }
 }
+
+/// Half-width ε of the rounded corners of the opening ([`crate::ramp`]).
+const SMOOTHING: ParamDecl = ParamDecl::number(
+    "smoothing",
+    "1",
+    "half-width ε of the opening's rounded corners, fraction of its pressure band",
+)
+.range(Range::closed(0.0, 0.5))
+.default(0.05);
+/// The seat's leak.
+const G_LEAK: ParamDecl =
+    ParamDecl::number("g_leak", "m³/(s·Pa)", "leak conductance of the closed seat")
+        .non_negative()
+        .default(1e-15);
+
+/// Kind `hydraulics.sequence_valve`.
+pub const KIND: KindDecl = KindDecl::element(
+    "hydraulics.sequence_valve",
+    "sequence valve P → A: x = ramp((P_P − p_crack)/dp_override), Q = α·x·regRoot(P_P − P_A)",
+    &[
+        orifice::ALPHA,
+        orifice::CD,
+        orifice::W,
+        orifice::RHO,
+        ParamDecl::number("p_crack", "Pa", "inlet pressure at which it opens").positive(),
+        ParamDecl::number(
+            "dp_override",
+            "Pa",
+            "pressure rise from cracking to fully open",
+        )
+        .positive()
+        .optional("0.1·p_crack"),
+        SMOOTHING,
+        G_LEAK,
+        orifice::P_TR,
+    ],
+    |p| {
+        let mut v = SequenceValve::new(orifice::alpha_of(p)?, p.number("p_crack")?);
+        if let Some(d) = p.optional("dp_override")? {
+            v.dp_override = d;
+        }
+        v.smoothing = p.number("smoothing")?;
+        v.g_leak = p.number("g_leak")?;
+        v.p_tr = p.number("p_tr")?;
+        Ok(Box::new(v.build()?))
+    },
+)
+.example("alpha = 1e-6, p_crack = 8e6");
 
 #[cfg(test)]
 mod tests {

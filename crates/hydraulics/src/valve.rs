@@ -17,6 +17,8 @@
 //! modulated `Sf`s, which read the chamber pressures). Draw the bonds from the valve to the
 //! lines: the bond flow is then Q_A (Q_B).
 
+use crate::orifice;
+use bondgraph::kind::{KindDecl, ParamDecl};
 use bondgraph::{
     CausalRule, Element, Io, LocalJacobian, Param, ParamError, PortCausality, PortSpec, Ports,
     SignalSpec, Slot, Stage,
@@ -163,6 +165,36 @@ impl Element for Valve {
         true
     }
 }
+
+/// Kind `hydraulics.valve`.
+pub const KIND: KindDecl = KindDecl::element(
+    "hydraulics.valve",
+    "4/3 directional valve, eqs. 29–30 with regRoot: ports A (piston side), B (rod side)",
+    &[
+        orifice::ALPHA,
+        orifice::CD,
+        orifice::W,
+        orifice::RHO,
+        ParamDecl::modulated(
+            "x_v",
+            "1",
+            "spool stroke, clamped to [−1, 1], e.g. \"spool.out\"",
+        ),
+        ParamDecl::number("p_s", "Pa", "supply pressure"),
+        ParamDecl::number("p_t", "Pa", "tank pressure").default(0.0),
+        orifice::P_TR,
+    ],
+    |p| {
+        Ok(Box::new(Valve::new(
+            orifice::alpha_of(p)?,
+            p.modulated("x_v")?,
+            p.number("p_s")?,
+            p.number("p_t")?,
+            p.number("p_tr")?,
+        )?))
+    },
+)
+.example("alpha = 1e-7, x_v = \"0.5*sin(t)\", p_s = 2e7");
 
 #[cfg(test)]
 mod tests {

@@ -14,6 +14,8 @@
 //!
 //! Causality: conductance at both ports. Dissipates Q·(P_P − P_A) ≥ 0.
 
+use crate::orifice;
+use bondgraph::kind::{KindDecl, ParamDecl};
 use bondgraph::{
     CausalRule, Element, Io, LocalJacobian, Param, ParamError, PortCausality, PortSpec, Ports,
     SignalSpec, Slot, Stage,
@@ -127,6 +129,34 @@ impl Element for Valve22 {
         true
     }
 }
+
+/// Kind `hydraulics.valve_2_2`.
+pub const KIND: KindDecl = KindDecl::element(
+    "hydraulics.valve_2_2",
+    "2/2 valve P → A: Q = α·u·regRoot(Δp) + g_leak·Δp, u ∈ [0, 1] (1 − u normally open)",
+    &[
+        orifice::ALPHA,
+        orifice::CD,
+        orifice::W,
+        orifice::RHO,
+        ParamDecl::modulated("u", "1", "command, clamped to [0, 1]"),
+        ParamDecl::flag("normally_open", false, "u = 0 is the open position"),
+        ParamDecl::number("g_leak", "m³/(s·Pa)", "leak conductance")
+            .non_negative()
+            .default(0.0),
+        orifice::P_TR,
+    ],
+    |p| {
+        Ok(Box::new(Valve22::new(
+            orifice::alpha_of(p)?,
+            p.modulated("u")?,
+            p.flag("normally_open")?,
+            p.number("g_leak")?,
+            p.number("p_tr")?,
+        )?))
+    },
+)
+.example("alpha = 1e-6, u = \"step(t - 1)\"");
 
 #[cfg(test)]
 mod tests {

@@ -15,6 +15,8 @@
 //!
 //! Causality: conductance at all three ports.
 
+use crate::orifice;
+use bondgraph::kind::{KindDecl, ParamDecl};
 use bondgraph::{
     CausalRule, Element, Io, LocalJacobian, Param, ParamError, PortCausality, PortSpec, Ports,
     SignalSpec, Slot, Stage,
@@ -148,6 +150,38 @@ impl Element for Valve32 {
         true
     }
 }
+
+/// Kind `hydraulics.valve_3_2`.
+pub const KIND: KindDecl = KindDecl::element(
+    "hydraulics.valve_3_2",
+    "3/2 valve, ports P, A, T: Q_PA = α·u·regRoot(·), Q_AT = α·(1 − u)·regRoot(·), u ∈ [0, 1]",
+    &[
+        orifice::ALPHA,
+        orifice::CD,
+        orifice::W,
+        orifice::RHO,
+        ParamDecl::modulated(
+            "u",
+            "1",
+            "command, clamped to [0, 1]: 0 connects A to T, 1 P to A",
+        ),
+        ParamDecl::flag("normally_open", false, "u = 0 connects P to A"),
+        ParamDecl::number("g_leak", "m³/(s·Pa)", "leak conductance of each edge")
+            .non_negative()
+            .default(0.0),
+        orifice::P_TR,
+    ],
+    |p| {
+        Ok(Box::new(Valve32::new(
+            orifice::alpha_of(p)?,
+            p.modulated("u")?,
+            p.flag("normally_open")?,
+            p.number("g_leak")?,
+            p.number("p_tr")?,
+        )?))
+    },
+)
+.example("alpha = 1e-6, u = \"step(t - 1)\"");
 
 #[cfg(test)]
 #[allow(clippy::float_cmp)] // exact zeros and copied flows are meant exactly

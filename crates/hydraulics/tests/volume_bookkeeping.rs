@@ -17,7 +17,7 @@
 
 mod common;
 
-use bg_hydraulics::{expand, Cylinder, InitialPressures, ValveSpec};
+use bg_hydraulics::{Cylinder, InitialPressures, ValveSpec};
 use bondgraph::*;
 use common::{col, integrator, output};
 
@@ -69,7 +69,7 @@ fn run(naive: bool) -> (Balance, Balance, Statistics) {
         }
     }
     let mut g = BondGraph::new();
-    expand(&mut g, "cyl", comp).unwrap();
+    comp.add_to("cyl", &mut g).unwrap();
     g.add("load", OneJunction).unwrap();
     g.add("mass", Inertia::new(MASS, 0.0).unwrap()).unwrap();
     g.add("gravity", EffortSource::new(-MASS * G)).unwrap();

@@ -12,8 +12,8 @@
 use nalgebra::{DMatrix, DVector, Vector2};
 
 use crate::arm::{z_cross, PlanarArm, Pose};
-use crate::error::ManipulatorError;
 use crate::pin::{Pin, PinPoint};
+use bondgraph::ParamError;
 
 /// A linear actuator (hydraulic cylinder) between pins `a` and `b`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -45,18 +45,18 @@ impl LinearActuator {
 
 impl PlanarArm {
     /// Check an actuator's pins lie on the arm and are apart in the configuration `q`.
-    pub fn check_actuator(&self, act: &LinearActuator, q: &[f64]) -> Result<(), ManipulatorError> {
+    pub fn check_actuator(&self, act: &LinearActuator, q: &[f64]) -> Result<(), ParamError> {
         self.check_pin(&act.a)?;
         self.check_pin(&act.b)?;
         if q.len() != self.n() {
-            return Err(ManipulatorError::shape(
+            return Err(ParamError::shape(
                 "q0",
                 format!("needs {} values", self.n()),
             ));
         }
         let l = act.length(&self.pose(q));
         if !(l.is_finite() && l > 0.0) {
-            return Err(ManipulatorError::invalid(
+            return Err(ParamError::invalid(
                 "actuator length",
                 l,
                 "> 0: the pins coincide",

@@ -15,13 +15,13 @@ use std::borrow::Cow;
 
 use nalgebra::Vector2;
 
-use crate::error::ManipulatorError;
 use crate::joint::RevoluteJoint;
 use crate::link::Link;
 use crate::pin::Pin;
 use crate::quadrature::GaussLegendre;
 use crate::screw::{rot_z_cs, CoordinateTransform};
 use crate::shape_integrals::ShapeIntegrals;
+use bondgraph::ParamError;
 
 /// A point on a link's axis at distance `x` along its chord, with the mode shapes evaluated
 /// there (`ψ_k(x)`, `θ_k(x)`).
@@ -50,7 +50,7 @@ pub struct PlanarArm {
 impl PlanarArm {
     /// A chain of `links` (at least one) under gravity `gravity` (m/s², along −y₀), with the
     /// default quadrature ([`GaussLegendre::DEFAULT_POINTS`] points per link).
-    pub fn new(links: Vec<Link>, gravity: f64) -> Result<Self, ManipulatorError> {
+    pub fn new(links: Vec<Link>, gravity: f64) -> Result<Self, ParamError> {
         Self::with_quadrature(links, gravity, GaussLegendre::DEFAULT_POINTS)
     }
 
@@ -61,14 +61,11 @@ impl PlanarArm {
         links: Vec<Link>,
         gravity: f64,
         points: usize,
-    ) -> Result<Self, ManipulatorError> {
+    ) -> Result<Self, ParamError> {
         if links.is_empty() {
-            return Err(ManipulatorError::shape(
-                "links",
-                "an arm needs at least one link",
-            ));
+            return Err(ParamError::shape("links", "an arm needs at least one link"));
         }
-        ManipulatorError::finite("gravity", gravity)?;
+        ParamError::finite("gravity", gravity)?;
         let quadrature = GaussLegendre::new(points)?;
         let mut modal_offset = Vec::with_capacity(links.len());
         let mut n = links.len();
@@ -148,9 +145,9 @@ impl PlanarArm {
     }
 
     /// The station at distance `x` along link `link`'s chord.
-    pub fn station(&self, link: usize, x: f64) -> Result<Station, ManipulatorError> {
+    pub fn station(&self, link: usize, x: f64) -> Result<Station, ParamError> {
         let l = self.links.get(link).ok_or_else(|| {
-            ManipulatorError::shape(
+            ParamError::shape(
                 "link",
                 format!(
                     "link {} does not exist (the arm has {})",
@@ -160,11 +157,7 @@ impl PlanarArm {
             )
         })?;
         if !(x.is_finite() && (0.0..=l.length()).contains(&x)) {
-            return Err(ManipulatorError::invalid(
-                "x",
-                x,
-                "on the link, 0 <= x <= L",
-            ));
+            return Err(ParamError::invalid("x", x, "on the link, 0 <= x <= L"));
         }
         Ok(self.station_unchecked(link, x))
     }
@@ -180,11 +173,11 @@ impl PlanarArm {
     }
 
     /// Check a pin lies on the arm (or is a finite ground point).
-    pub fn check_pin(&self, pin: &Pin) -> Result<(), ManipulatorError> {
+    pub fn check_pin(&self, pin: &Pin) -> Result<(), ParamError> {
         match *pin {
             Pin::Ground(p) => {
-                ManipulatorError::finite("pin.x", p.x)?;
-                ManipulatorError::finite("pin.y", p.y)?;
+                ParamError::finite("pin.x", p.x)?;
+                ParamError::finite("pin.y", p.y)?;
                 Ok(())
             }
             Pin::Link { link, x } => self.station(link, x).map(|_| ()),

@@ -39,17 +39,17 @@
 //! [`elements`]: the I-field ([`ArmInertia`]), C-field ([`ArmCompliance`]), R-field
 //! ([`ArmDamping`]), the MTFs to the cylinders ([`ActuatorTransformer`]) and to the lumped
 //! masses ([`LumpedMassTransformer`]), the lumped masses themselves, and the reaction-force
-//! block ([`ArmReactions`]). [`ArmScene`] wires them into a graph; [`register()`] offers the
+//! block ([`ArmReactions`]). [`ArmScene`] wires them into a graph; [`KINDS`] offers the
 //! scene to model files as the composite kind `manipulator.planar_arm`.
 
 pub mod actuator;
 pub mod arm;
 mod cholesky;
 pub mod elements;
-pub mod error;
 pub mod gravity;
 pub mod hessians;
 pub mod joint;
+pub mod kinds;
 pub mod kinematics;
 pub mod kinetic_forces;
 pub mod link;
@@ -61,7 +61,6 @@ pub mod projection;
 pub mod quadrature;
 pub mod reactions;
 pub mod reference;
-pub mod register;
 pub mod scene;
 pub mod screw;
 pub mod shape_integrals;
@@ -73,8 +72,8 @@ pub use elements::{
     lumped_masses, ActuatorTransformer, ArmCompliance, ArmDamping, ArmInertia, ArmReactions,
     LumpedGravity, LumpedMassTransformer,
 };
-pub use error::ManipulatorError;
 pub use joint::RevoluteJoint;
+pub use kinds::KINDS;
 pub use kinematics::ArmKinematics;
 pub use link::{Link, PointMass};
 pub use lumped_mass::LumpedMass;
@@ -83,7 +82,6 @@ pub use pin::{Pin, PinPoint};
 pub use projection::Projection;
 pub use quadrature::GaussLegendre;
 pub use reactions::PointLoad;
-pub use register::register;
-pub use scene::{ArmScene, LumpedMassModel, SceneError};
+pub use scene::{ArmScene, LumpedMassModel};
 pub use screw::{CoordinateTransform, ReferenceTransform, ScrewTransform};
 pub use shape_integrals::ShapeIntegrals;

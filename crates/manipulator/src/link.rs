@@ -13,8 +13,8 @@
 
 use std::sync::Arc;
 
-use crate::error::ManipulatorError;
 use crate::mode_shape::{ModeShape, SineMode};
+use bondgraph::ParamError;
 
 /// A point mass on the deformed axis of a link, at distance `x` along the chord.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -41,10 +41,10 @@ pub struct Link {
 impl Link {
     /// A rigid uniform link: length `length` (m, > 0), mass per length `mass_per_length`
     /// (kg/m, ≥ 0).
-    pub fn rigid(length: f64, mass_per_length: f64) -> Result<Self, ManipulatorError> {
+    pub fn rigid(length: f64, mass_per_length: f64) -> Result<Self, ParamError> {
         Ok(Self {
-            length: ManipulatorError::positive("length", length)?,
-            mass_per_length: ManipulatorError::non_negative("mass_per_length", mass_per_length)?,
+            length: ParamError::positive("length", length)?,
+            mass_per_length: ParamError::non_negative("mass_per_length", mass_per_length)?,
             rotary_inertia_per_length: 0.0,
             bending_stiffness: 0.0,
             modes: Vec::new(),
@@ -56,11 +56,11 @@ impl Link {
     /// `rho` (kg/m³), cross-section area `a` (m²) and second moment of area `i` (m⁴): mass
     /// per length ρA, rotary inertia per length ρI (eq. 40), bending stiffness EI (eq. 50).
     /// Rigid until modes are added ([`with_sine_modes`](Self::with_sine_modes)).
-    pub fn beam(length: f64, e: f64, rho: f64, a: f64, i: f64) -> Result<Self, ManipulatorError> {
-        let e = ManipulatorError::positive("E", e)?;
-        let rho = ManipulatorError::positive("rho", rho)?;
-        let a = ManipulatorError::positive("A", a)?;
-        let i = ManipulatorError::positive("I", i)?;
+    pub fn beam(length: f64, e: f64, rho: f64, a: f64, i: f64) -> Result<Self, ParamError> {
+        let e = ParamError::positive("E", e)?;
+        let rho = ParamError::positive("rho", rho)?;
+        let a = ParamError::positive("A", a)?;
+        let i = ParamError::positive("I", i)?;
         let mut link = Self::rigid(length, rho * a)?;
         link.rotary_inertia_per_length = rho * i;
         link.bending_stiffness = e * i;
@@ -69,7 +69,7 @@ impl Link {
 
     /// The payload pendulum: a rigid massless link of length `length` with a point mass
     /// `mass` at its end (its frame's x axis points from the pivot to the payload).
-    pub fn pendulum(length: f64, mass: f64) -> Result<Self, ManipulatorError> {
+    pub fn pendulum(length: f64, mass: f64) -> Result<Self, ParamError> {
         Self::rigid(length, 0.0)?.with_point_mass(PointMass {
             x: length,
             mass,
@@ -78,20 +78,20 @@ impl Link {
     }
 
     /// Set the rotary inertia per length ρI (kg·m).
-    pub fn with_rotary_inertia(mut self, per_length: f64) -> Result<Self, ManipulatorError> {
+    pub fn with_rotary_inertia(mut self, per_length: f64) -> Result<Self, ParamError> {
         self.rotary_inertia_per_length =
-            ManipulatorError::non_negative("rotary_inertia_per_length", per_length)?;
+            ParamError::non_negative("rotary_inertia_per_length", per_length)?;
         Ok(self)
     }
 
     /// Set the bending stiffness EI (N·m²).
-    pub fn with_bending_stiffness(mut self, ei: f64) -> Result<Self, ManipulatorError> {
-        self.bending_stiffness = ManipulatorError::non_negative("EI", ei)?;
+    pub fn with_bending_stiffness(mut self, ei: f64) -> Result<Self, ParamError> {
+        self.bending_stiffness = ParamError::non_negative("EI", ei)?;
         Ok(self)
     }
 
     /// Add the first `n` hinged–hinged sine modes `sin(kπx/L)`, k = 1..n.
-    pub fn with_sine_modes(self, n: u32) -> Result<Self, ManipulatorError> {
+    pub fn with_sine_modes(self, n: u32) -> Result<Self, ParamError> {
         let l = self.length;
         (1..=n).try_fold(self, |link, k| {
             link.with_mode(Arc::new(SineMode::new(k, l)))
@@ -100,8 +100,8 @@ impl Link {
 
     /// Add an assumed mode. It must vanish at both ends of the chord (chord-to-chord joint
     /// angles), and the link must have a bending stiffness.
-    pub fn with_mode(mut self, mode: Arc<dyn ModeShape>) -> Result<Self, ManipulatorError> {
-        ManipulatorError::positive("EI", self.bending_stiffness)?;
+    pub fn with_mode(mut self, mode: Arc<dyn ModeShape>) -> Result<Self, ParamError> {
+        ParamError::positive("EI", self.bending_stiffness)?;
         let scale = (0..=16)
             .map(|k| mode.value(self.length * f64::from(k) / 16.0).abs())
             .fold(0.0, f64::max)
@@ -109,7 +109,7 @@ impl Link {
         for x in [0.0, self.length] {
             let v = mode.value(x);
             if !v.is_finite() || v.abs() > 1e-9 * scale {
-                return Err(ManipulatorError::shape(
+                return Err(ParamError::shape(
                     "modes",
                     format!(
                         "a mode must vanish at both ends of the chord (chord-to-chord joint angles), but ψ({x}) = {v}"
@@ -122,16 +122,16 @@ impl Link {
     }
 
     /// Add a point mass on the deformed axis.
-    pub fn with_point_mass(mut self, m: PointMass) -> Result<Self, ManipulatorError> {
+    pub fn with_point_mass(mut self, m: PointMass) -> Result<Self, ParamError> {
         if !(m.x.is_finite() && (0.0..=self.length).contains(&m.x)) {
-            return Err(ManipulatorError::invalid(
+            return Err(ParamError::invalid(
                 "point_mass.x",
                 m.x,
                 "within the link, 0 <= x <= L",
             ));
         }
-        ManipulatorError::non_negative("point_mass.mass", m.mass)?;
-        ManipulatorError::non_negative("point_mass.inertia", m.inertia)?;
+        ParamError::non_negative("point_mass.mass", m.mass)?;
+        ParamError::non_negative("point_mass.inertia", m.inertia)?;
         self.masses.push(m);
         Ok(self)
     }

@@ -10,8 +10,8 @@
 use nalgebra::DMatrix;
 
 use crate::arm::{PlanarArm, Pose};
-use crate::error::ManipulatorError;
 use crate::pin::{Pin, PinPoint};
+use bondgraph::ParamError;
 
 /// A point mass at a pin on a link.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -24,10 +24,10 @@ pub struct LumpedMass {
 
 impl PlanarArm {
     /// Check a lumped mass sits on a link and has a positive mass.
-    pub fn check_lumped_mass(&self, m: &LumpedMass) -> Result<(), ManipulatorError> {
-        ManipulatorError::positive("lumped mass", m.mass)?;
+    pub fn check_lumped_mass(&self, m: &LumpedMass) -> Result<(), ParamError> {
+        ParamError::positive("lumped mass", m.mass)?;
         match m.pin {
-            Pin::Ground(_) => Err(ManipulatorError::shape(
+            Pin::Ground(_) => Err(ParamError::shape(
                 "lumped mass",
                 "a lumped mass on the ground does not move: leave it out",
             )),

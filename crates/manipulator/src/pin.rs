@@ -7,7 +7,7 @@
 use nalgebra::Vector2;
 
 use crate::arm::{PlanarArm, Pose, Station};
-use crate::error::ManipulatorError;
+use bondgraph::ParamError;
 
 /// An attachment point.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -59,7 +59,7 @@ impl PinPoint {
 
 impl PlanarArm {
     /// Resolve `pin` on this arm (checks it lies on the arm).
-    pub fn resolve_pin(&self, pin: &Pin) -> Result<PinPoint, ManipulatorError> {
+    pub fn resolve_pin(&self, pin: &Pin) -> Result<PinPoint, ParamError> {
         self.check_pin(pin)?;
         match *pin {
             Pin::Ground(p) => Ok(PinPoint::Ground(p)),

@@ -16,7 +16,7 @@
 //! convergence of M(q) at deformed configurations. With more modes, raise the point count
 //! (about 5 points per mode is plenty).
 
-use crate::error::ManipulatorError;
+use bondgraph::ParamError;
 
 /// Nodes and weights of an n-point Gauss–Legendre rule on `[0, 1]`.
 #[derive(Clone, Debug, PartialEq)]
@@ -30,9 +30,9 @@ impl GaussLegendre {
     pub const DEFAULT_POINTS: usize = 16;
 
     /// The n-point rule (n ≥ 1), nodes by Newton's method on the Legendre polynomial P_n.
-    pub fn new(n: usize) -> Result<Self, ManipulatorError> {
+    pub fn new(n: usize) -> Result<Self, ParamError> {
         if n == 0 || n > 512 {
-            return Err(ManipulatorError::invalid(
+            return Err(ParamError::invalid(
                 "quadrature_points",
                 n as f64,
                 "an integer in 1..=512",

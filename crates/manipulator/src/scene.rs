@@ -22,9 +22,10 @@
 
 use std::sync::Arc;
 
-use bg_model::Composite;
+use bondgraph::kind::member_name;
 use bondgraph::{
-    BondGraph, Capacitor, ElementId, GraphError, OneJunction, ParamError, Resistor, ZeroJunction,
+    BondGraph, Capacitor, Composite, ElementId, Error, OneJunction, ParamError, Resistor,
+    ZeroJunction,
 };
 use nalgebra::DVector;
 
@@ -35,7 +36,6 @@ use crate::elements::{
     ActuatorTransformer, ArmCompliance, ArmDamping, ArmInertia, ArmReactions, LumpedGravity,
     LumpedMassTransformer,
 };
-use crate::error::ManipulatorError;
 use crate::link::{Link, PointMass};
 use crate::lumped_mass::LumpedMass;
 use crate::quadrature::GaussLegendre;
@@ -85,9 +85,9 @@ pub struct ArmScene {
 }
 
 /// Pad `v` with zeros to length `n`, or complain that it is longer.
-fn padded(name: &str, v: &[f64], n: usize) -> Result<Vec<f64>, ManipulatorError> {
+fn padded(name: &str, v: &[f64], n: usize) -> Result<Vec<f64>, ParamError> {
     if v.len() > n {
-        return Err(ManipulatorError::shape(
+        return Err(ParamError::shape(
             name,
             format!("has {} values, the arm has {n} coordinates", v.len()),
         ));
@@ -118,21 +118,18 @@ impl ArmScene {
 
     /// The arm this scene simulates (with the lumped masses as point masses if they are
     /// rigidly attached).
-    pub fn arm(&self) -> Result<PlanarArm, ManipulatorError> {
+    pub fn arm(&self) -> Result<PlanarArm, ParamError> {
         let mut links = self.links.clone();
         if self.lumped_model == LumpedMassModel::Rigid {
             for m in &self.lumped_masses {
                 let crate::Pin::Link { link, x } = m.pin else {
-                    return Err(ManipulatorError::shape(
+                    return Err(ParamError::shape(
                         "lumped_masses",
                         "a lumped mass must sit on a link",
                     ));
                 };
                 let l = links.get_mut(link).ok_or_else(|| {
-                    ManipulatorError::shape(
-                        "lumped_masses",
-                        format!("link {} does not exist", link + 1),
-                    )
+                    ParamError::shape("lumped_masses", format!("link {} does not exist", link + 1))
                 })?;
                 *l = l.clone().with_point_mass(PointMass {
                     x,
@@ -146,7 +143,8 @@ impl ArmScene {
 
     /// The members, internal bonds and exposed ports; `member` gives the global name of a
     /// member from its local name (for the signals members read from each other).
-    pub fn composite(&self, member: &dyn Fn(&str) -> String) -> Result<Composite, ParamError> {
+    pub fn composite(&self, instance: &str) -> Result<Composite, ParamError> {
+        let member = |l: &str| member_name(instance, l);
         let arm = Arc::new(self.arm()?);
         let n = arm.n();
         let q0 = padded("q0", &self.q0, n)?;
@@ -183,7 +181,7 @@ impl ArmScene {
         if let (LumpedMassModel::Springs { stiffness, damping }, false) =
             (self.lumped_model, springs.is_empty())
         {
-            ManipulatorError::positive("lumped_stiffness", stiffness)?;
+            ParamError::positive("lumped_stiffness", stiffness)?;
             let pins: Vec<_> = springs.iter().map(|m| m.pin).collect();
             let masses: Vec<f64> = springs.iter().map(|m| m.mass).collect();
             let v0 =
@@ -236,47 +234,22 @@ impl ArmScene {
         &self,
         g: &mut BondGraph,
         name: &str,
-    ) -> Result<Vec<(String, ElementId, Option<usize>)>, SceneError> {
-        let global = |l: &str| format!("{name}_{l}");
-        let c = self.composite(&global)?;
-        for (local, el) in c.elements {
-            g.add_boxed(&global(&local), el)?;
-        }
-        let end = |g: &BondGraph, s: &str| -> Result<(ElementId, Option<usize>), GraphError> {
-            let (el, port) = s.split_once('.').map_or((s, None), |(e, p)| (e, Some(p)));
-            let id = g
-                .find(&global(el))
-                .ok_or_else(|| GraphError::UnknownElement { name: global(el) })?;
-            Ok((id, port.map(|p| g.port_index(id, p)).transpose()?))
-        };
-        for (b, from, to) in &c.bonds {
-            let (f, t) = (end(g, from)?, end(g, to)?);
-            g.connect_named(&global(b), f, t)?;
-        }
-        c.ports
-            .iter()
+    ) -> Result<Vec<(String, ElementId, Option<usize>)>, Error> {
+        let ports = self.composite(name)?.add_to(name, g)?;
+        ports
+            .into_iter()
             .map(|(p, inner)| {
-                let (id, port) = end(g, inner)?;
-                Ok((p.clone(), id, port))
+                let (el, port) = inner
+                    .split_once('.')
+                    .map_or((inner.as_str(), None), |(e, p)| (e, Some(p)));
+                let id = g
+                    .find(el)
+                    .ok_or_else(|| bondgraph::GraphError::UnknownElement {
+                        name: el.to_owned(),
+                    })?;
+                let port = port.map(|q| g.port_index(id, q)).transpose()?;
+                Ok((p, id, port))
             })
             .collect()
-    }
-}
-
-/// Why a scene could not be added to a graph.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum SceneError {
-    /// A parameter is wrong.
-    #[error(transparent)]
-    Param(#[from] ParamError),
-    /// The graph refused a member or bond.
-    #[error(transparent)]
-    Graph(#[from] GraphError),
-}
-
-impl From<ManipulatorError> for SceneError {
-    fn from(e: ManipulatorError) -> Self {
-        Self::Param(e.into())
     }
 }

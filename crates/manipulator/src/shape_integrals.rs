@@ -35,10 +35,10 @@
 
 use nalgebra::DMatrix;
 
-use crate::error::ManipulatorError;
 use crate::link::Link;
 use crate::mode_shape::ModeShape;
 use crate::quadrature::GaussLegendre;
+use bondgraph::ParamError;
 
 /// The Gram matrices of one link's station features.
 #[derive(Clone, Debug, PartialEq)]
@@ -85,7 +85,7 @@ impl ShapeIntegrals {
 
     /// The integrals of `link`; modes other than sines are integrated with
     /// `max(points, MIN_QUADRATURE_POINTS)` Gauss–Legendre points.
-    pub fn of(link: &Link, points: usize) -> Result<Self, ManipulatorError> {
+    pub fn of(link: &Link, points: usize) -> Result<Self, ParamError> {
         let m = link.modes().len();
         let mut s = Self {
             translation: DMatrix::zeros(m + 2, m + 2),

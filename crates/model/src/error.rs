@@ -2,6 +2,7 @@
 //! concerned and a hint.
 
 use std::fmt;
+use std::sync::Arc;
 
 /// What kind of problem a [`ModelError`] reports.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -34,7 +35,7 @@ pub enum ErrorKind {
 }
 
 /// A problem in a model file.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug)]
 pub struct ModelError {
     /// What kind of problem.
     pub kind: ErrorKind,
@@ -50,7 +51,29 @@ pub struct ModelError {
     pub message: String,
     /// What to do about it.
     pub hint: Option<String>,
+    /// The error underneath (an element's [`bondgraph::BuildError`], a core
+    /// [`bondgraph::Error`]), for [`std::error::Error::source`].
+    pub source: Option<Arc<dyn std::error::Error + Send + Sync>>,
 }
+
+impl PartialEq for ModelError {
+    /// Equal when everything but the source is.
+    fn eq(&self, o: &Self) -> bool {
+        (
+            self.kind,
+            &self.file,
+            self.line,
+            self.col,
+            &self.element,
+            &self.message,
+            &self.hint,
+        ) == (
+            o.kind, &o.file, o.line, o.col, &o.element, &o.message, &o.hint,
+        )
+    }
+}
+
+impl Eq for ModelError {}
 
 impl ModelError {
     pub(crate) fn new(kind: ErrorKind, file: &str, message: impl Into<String>) -> Self {
@@ -62,6 +85,7 @@ impl ModelError {
             element: None,
             message: clip_to(&message.into(), MAX_MESSAGE),
             hint: None,
+            source: None,
         }
     }
     pub(crate) fn at(mut self, pos: Option<(usize, usize)>) -> Self {
@@ -75,8 +99,16 @@ impl ModelError {
         self.element = Some(name.to_owned());
         self
     }
-    pub(crate) fn hint(mut self, hint: impl Into<String>) -> Self {
+    /// With a hint.
+    #[must_use]
+    pub fn hint(mut self, hint: impl Into<String>) -> Self {
         self.hint = Some(clip_to(&hint.into(), MAX_MESSAGE));
+        self
+    }
+    /// With the error underneath.
+    #[must_use]
+    pub fn with_source(mut self, source: impl std::error::Error + Send + Sync + 'static) -> Self {
+        self.source = Some(Arc::new(source));
         self
     }
 }
@@ -102,7 +134,13 @@ impl fmt::Display for ModelError {
     }
 }
 
-impl std::error::Error for ModelError {}
+impl std::error::Error for ModelError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        self.source
+            .as_deref()
+            .map(|e| e as &(dyn std::error::Error + 'static))
+    }
+}
 
 /// Longest piece of user input an error message repeats, in characters.
 pub const MAX_ECHO: usize = 80;

@@ -33,26 +33,29 @@
 //! …), each a `--set` key with its choices; [`Model::scene`] exposes them ([`scene`]).
 //!
 //! ## Element kinds
-//! [`Registry::with_core`] knows the core kinds (see [`builtin`]); domain crates register
-//! theirs with [`Registry::register`] and read parameters through [`ElementSpec`].
+//! [`Registry::with_core`] knows the core kinds ([`bondgraph::kinds`]); domain crates hand
+//! over theirs with [`Registry::add`]. Each kind is a [`bondgraph::KindDecl`]: parameters
+//! declared as data, read for its builder by an [`ElementSpec`] ([`reader`]), which turns
+//! every problem into a [`ModelError`] at the parameter's line.
 //!
 //! ## Expressions
 //! Parameters and element values may be expressions ([`expr`]): `"pi/4*d^2"`, `"1/k"`, or,
 //! where an element allows modulation, functions of signals and time: `"1 + 0.1*spring.q"`.
 
-pub mod builtin;
+pub mod describe;
 pub mod error;
 pub mod expr;
 pub mod load;
 pub mod overrides;
+pub mod reader;
 pub mod registry;
 pub mod scene;
 pub mod steady;
 
+pub use describe::{describe, parameter_table, KindReport};
 pub use error::{ErrorKind, ModelError};
 pub use load::{inspect, Check, CheckResult, Inspection, Model};
-pub use registry::{
-    BuildFn, Builder, Composite, CompositeFn, ElementSpec, KindInfo, RawValue, Registry,
-};
+pub use reader::{ElementSpec, RawValue};
+pub use registry::Registry;
 pub use scene::{Choice, Scene, Switch};
 pub use steady::SteadyReport;

@@ -17,7 +17,8 @@ use toml::Spanned;
 
 use crate::error::{clip, line_col, ErrorKind, ModelError};
 use crate::expr::{Expr, RESERVED};
-use crate::registry::{ElementSpec, RawValue, Registry};
+use crate::reader::{ElementSpec, RawValue};
+use crate::registry::Registry;
 use crate::scene::Scene;
 
 type SpannedMap<V> = IndexMap<Spanned<String>, Spanned<V>>;
@@ -244,7 +245,7 @@ type Replacements = Vec<(bondgraph::ElementId, Box<dyn Element>)>;
 /// What one model-file entry builds into.
 enum BuiltDef {
     One(Box<dyn Element>),
-    Many(crate::registry::Composite),
+    Many(bondgraph::Composite),
 }
 
 /// A parameter being evaluated: its expression, the names it uses and the next to look at.
@@ -433,7 +434,7 @@ impl Source {
         constants: &IndexMap<String, f64>,
     ) -> Result<(BuiltDef, HashSet<String>), ModelError> {
         let info = self.registry.get(&def.kind).ok_or_else(|| {
-            let mut kinds: Vec<&str> = self.registry.kinds().map(|(k, _)| k).collect();
+            let mut kinds: Vec<&str> = self.registry.kinds().map(|k| k.name).collect();
             kinds.sort_unstable();
             let close: Vec<&str> = kinds
                 .iter()
@@ -459,42 +460,29 @@ impl Source {
             .element(&def.name)
             .hint(hint)
         })?;
-        let spec = ElementSpec {
-            name: &def.name,
-            kind: &def.kind,
-            params: &def.params,
+        let used = RefCell::new(HashSet::new());
+        let spec = ElementSpec::new(
+            &def.name,
+            &def.kind,
+            info.params,
+            def.params.clone(),
             constants,
-            file: &self.file,
-            text: &self.text,
-            name_span: def.name_span.clone(),
-            asked: RefCell::new(Vec::new()),
-            used_constants: RefCell::new(HashSet::new()),
-        };
+            &self.file,
+            &self.text,
+            def.name_span.clone(),
+            &used,
+        );
+        spec.validate().map_err(|e| spec.locate(e))?;
         let element = match info.build {
-            crate::registry::Builder::Element(f) => BuiltDef::One(f(&spec)?),
-            crate::registry::Builder::Composite(f) => BuiltDef::Many(f(&spec)?),
+            bondgraph::kind::Build::Element(f) => {
+                BuiltDef::One(f(&spec).map_err(|e| spec.locate(e))?)
+            }
+            bondgraph::kind::Build::Composite(f) => {
+                BuiltDef::Many(f(&spec).map_err(|e| spec.locate(e))?)
+            }
         };
-        let (unused, asked) = spec.unused();
-        if let Some(k) = unused.first() {
-            let close = asked.iter().find(|a| {
-                a.eq_ignore_ascii_case(k)
-                    || (a.len() > 1 && (k.starts_with(a.as_str()) || a.starts_with(k.as_str())))
-            });
-            let takes = if asked.is_empty() {
-                "it takes none".to_owned()
-            } else {
-                format!("it takes: {}", asked.join(", "))
-            };
-            let hint = close.map_or(takes.clone(), |c| format!("did you mean `{c}`? {takes}"));
-            return Err(spec
-                .error(
-                    k,
-                    ErrorKind::ExtraParameter,
-                    format!("({}) has no parameter `{k}`", def.kind),
-                )
-                .hint(hint));
-        }
-        Ok((element, spec.used_constants.into_inner()))
+        drop(spec);
+        Ok((element, used.into_inner()))
     }
 }
 
@@ -510,26 +498,8 @@ impl Source {
         match built {
             BuiltDef::One(e) => Ok((vec![(def.name.clone(), e)], Vec::new(), Vec::new(), used)),
             BuiltDef::Many(c) => {
-                let global = |local: &str| format!("{}_{local}", def.name);
-                let global_end = |end: &str| match end.split_once('.') {
-                    Some((el, port)) => format!("{}.{port}", global(el)),
-                    None => global(end),
-                };
-                let members = c
-                    .elements
-                    .into_iter()
-                    .map(|(n, e)| (global(&n), e))
-                    .collect();
-                let bonds = c
-                    .bonds
-                    .iter()
-                    .map(|(n, a, b)| (global(n), global_end(a), global_end(b)))
-                    .collect();
-                let ports = c
-                    .ports
-                    .iter()
-                    .map(|(n, inner)| (n.clone(), global_end(inner)))
-                    .collect();
+                let x = c.expand(&def.name);
+                let (members, bonds, ports) = (x.elements, x.bonds, x.ports);
                 Ok((members, bonds, ports, used))
             }
         }

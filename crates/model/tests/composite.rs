@@ -2,13 +2,14 @@
 //! ports, is listed member by member, and is rebuilt by events.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use bg_model::{Composite, ElementSpec, ErrorKind, Model, ModelError, Registry};
-use bondgraph::{Capacitor, OneJunction, Resistor};
+use bg_model::{ErrorKind, Model, Registry};
+use bondgraph::kind::{BuildError, KindDecl, ParamDecl, Params};
+use bondgraph::{Capacitor, Composite, OneJunction, Resistor};
 
 /// An RC branch: a 1-junction carrying a resistor and a capacitor, exposed as port `in`.
-fn rc_branch(s: &ElementSpec<'_>) -> Result<Composite, ModelError> {
-    let r = Resistor::new(s.param("r", "resistance")?).map_err(|e| s.param_error(&e))?;
-    let c = Capacitor::new(s.number("c", "capacitance")?, 0.0).map_err(|e| s.param_error(&e))?;
+fn rc_branch(s: &dyn Params) -> Result<Composite, BuildError> {
+    let r = Resistor::new(s.modulated("r")?)?;
+    let c = Capacitor::new(s.number("c")?, 0.0)?;
     let mut comp = Composite::default();
     comp.element("loop", OneJunction)
         .element("r", r)
@@ -21,7 +22,16 @@ fn rc_branch(s: &ElementSpec<'_>) -> Result<Composite, ModelError> {
 
 fn registry() -> Registry {
     let mut r = Registry::with_core();
-    r.register_composite("test.rc", "an RC branch", rc_branch);
+    const PARAMS: &[ParamDecl] = &[
+        ParamDecl::modulated("r", "Ω", "resistance").non_negative(),
+        ParamDecl::number("c", "F", "capacitance").positive(),
+    ];
+    r.register(KindDecl::composite(
+        "test.rc",
+        "an RC branch",
+        PARAMS,
+        rc_branch,
+    ));
     r
 }
 

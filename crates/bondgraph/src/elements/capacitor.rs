@@ -12,6 +12,7 @@ use crate::element::{
 };
 use crate::elements::component_names;
 use crate::error::ParamError;
+use crate::kind::{BuildError, KindDecl, ParamDecl, Params};
 use crate::local_jacobian::LocalJacobian;
 
 /// Capacitor (spring, compliance). Compliance `c` in flow·time/effort (F, m/N, m³/Pa).
@@ -102,6 +103,48 @@ impl Element for Capacitor {
         let c = self.c.constant()?;
         Some(x.iter().map(|q| q * q / (2.0 * c)).sum())
     }
+}
+
+/// Kind `C`: `dq/dt = f`, `e = q/c`.
+pub const KIND: KindDecl = KindDecl::element(
+    "C",
+    "capacitor: dq/dt = f, e = q/c (or k·q)",
+    &[
+        ParamDecl::modulated("c", "", "compliance q/e (may read signals)")
+            .positive()
+            .optional("give `c` or `k`"),
+        ParamDecl::modulated("k", "", "stiffness e/q = 1/c (may read signals)")
+            .positive()
+            .optional("give `c` or `k`"),
+        ParamDecl::vector("q0", "", "initial displacement (a list for a multibond)").default(0.0),
+    ],
+    build,
+)
+.example("k = 100.0, q0 = 0.01");
+
+fn build(p: &dyn Params) -> Result<Box<dyn Element>, BuildError> {
+    let c = match (p.has("c"), p.has("k")) {
+        (true, false) => p.modulated("c")?,
+        (false, true) => match p.modulated("k")? {
+            Param::Const(k) => Param::Const(1.0 / k),
+            Param::Modulated { inputs, law } => {
+                Param::modulated(inputs, move |t, u| 1.0 / law(t, u))
+            }
+        },
+        (true, true) => {
+            return Err(BuildError::conflict(
+                "k",
+                "give either `c` (compliance) or `k` (stiffness), not both",
+            ))
+        }
+        (false, false) => {
+            return Err(
+                BuildError::missing("c", "needs `c` (compliance) or `k` (stiffness)")
+                    .hint(format!("add `c = …` or `k = …` to element `{}`", p.name())),
+            )
+        }
+    };
+    Ok(Box::new(Capacitor::multi(c, p.vector("q0")?)?))
 }
 
 #[cfg(test)]

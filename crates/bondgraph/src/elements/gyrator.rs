@@ -8,6 +8,7 @@
 use crate::bond::PortCausality;
 use crate::element::{CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Slot, Stage};
 use crate::error::ParamError;
+use crate::kind::{KindDecl, ParamDecl};
 use crate::local_jacobian::LocalJacobian;
 
 /// Gyrator with (possibly modulated) modulus `r` (units e₁/f₂, e.g. N·m/A).
@@ -113,6 +114,24 @@ impl Element for Gyrator {
         true
     }
 }
+
+/// Kind `GY`: `e₁ = r·f₂`, `e₂ = r·f₁`, constant modulus.
+pub const GY: KindDecl = KindDecl::element(
+    "GY",
+    "gyrator: e1 = r·f2, e2 = r·f1",
+    &[ParamDecl::number("r", "", "modulus")],
+    |p| Ok(Box::new(Gyrator::new(p.number("r")?)?)),
+)
+.example("r = 0.1");
+
+/// Kind `MGY`: a gyrator whose modulus reads signals.
+pub const MGY: KindDecl = KindDecl::element(
+    "MGY",
+    "modulated gyrator: r = r(signals)",
+    &[ParamDecl::modulated("r", "", "modulus (may read signals)")],
+    |p| Ok(Box::new(Gyrator::new(p.modulated("r")?)?)),
+)
+.example("r = 0.1");
 
 #[cfg(test)]
 mod tests {

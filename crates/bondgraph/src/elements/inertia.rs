@@ -11,6 +11,7 @@ use crate::element::{
 };
 use crate::elements::component_names;
 use crate::error::ParamError;
+use crate::kind::{BuildError, KindDecl, ParamDecl, Params};
 use crate::local_jacobian::LocalJacobian;
 
 /// Inertia (mass, inductance). Inertance `m` in effort·time/flow (kg, H, kg/m⁴).
@@ -129,6 +130,49 @@ impl Element for Inertia {
                 .sum(),
         )
     }
+}
+
+/// Kind `I`: `dp/dt = e`, `f = p/m`.
+pub const KIND: KindDecl = KindDecl::element(
+    "I",
+    "inertia: dp/dt = e, f = p/m",
+    &[
+        ParamDecl::modulated("m", "", "inertance (mass) p/f (may read signals)").positive(),
+        ParamDecl::vector("p0", "", "initial momentum (a list for a multibond)")
+            .optional("0, or from `v0`"),
+        ParamDecl::vector(
+            "v0",
+            "",
+            "initial flow, instead of `p0` (needs a constant `m`)",
+        )
+        .optional("0"),
+    ],
+    build,
+)
+.example("m = 2.0, v0 = 0.5");
+
+fn build(p: &dyn Params) -> Result<Box<dyn Element>, BuildError> {
+    let m = p.modulated("m")?;
+    let p0 = if p.has("v0") {
+        if p.has("p0") {
+            return Err(BuildError::conflict(
+                "v0",
+                "give either `p0` (momentum) or `v0` (flow), not both",
+            ));
+        }
+        let Some(mass) = m.constant() else {
+            return Err(BuildError::conflict(
+                "v0",
+                "`v0` needs a constant `m`; give `p0` instead",
+            ));
+        };
+        p.vector("v0")?.into_iter().map(|v| mass * v).collect()
+    } else if p.has("p0") {
+        p.vector("p0")?
+    } else {
+        vec![0.0]
+    };
+    Ok(Box::new(Inertia::multi(m, p0)?))
 }
 
 #[cfg(test)]

@@ -8,6 +8,7 @@
 
 use crate::bond::PortCausality;
 use crate::element::{CausalRule, Element, Io, Layout, Ports, Slot, Stage};
+use crate::kind::KindDecl;
 use crate::local_jacobian::LocalJacobian;
 
 fn dominant(io: &Io<'_>, c: PortCausality) -> usize {
@@ -154,6 +155,22 @@ impl Element for OneJunction {
         true
     }
 }
+
+/// Kind `0`: common effort, flows sum to zero.
+pub const ZERO: KindDecl = KindDecl::element(
+    "0",
+    "0-junction: common effort, flows sum to zero",
+    &[],
+    |_| Ok(Box::new(ZeroJunction)),
+);
+
+/// Kind `1`: common flow, efforts sum to zero.
+pub const ONE: KindDecl = KindDecl::element(
+    "1",
+    "1-junction: common flow, efforts sum to zero",
+    &[],
+    |_| Ok(Box::new(OneJunction)),
+);
 
 #[cfg(test)]
 mod tests {

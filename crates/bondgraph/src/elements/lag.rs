@@ -6,6 +6,7 @@
 use crate::bond::PortCausality;
 use crate::element::{CausalRule, Element, Io, Ports, SignalSpec, Slot, Stage, StateSpec};
 use crate::error::ParamError;
+use crate::kind::{KindDecl, ParamDecl};
 use crate::local_jacobian::LocalJacobian;
 
 /// First-order lag with time constant `tau` (s, > 0) reading the signal `input`.
@@ -69,6 +70,25 @@ impl Element for Lag {
         true
     }
 }
+
+/// Kind `lag`: `τ·dy/dt = u − y`.
+pub const KIND: KindDecl = KindDecl::element(
+    "lag",
+    "first-order lag: tau·dy/dt = input − y",
+    &[
+        ParamDecl::signal("input", "", "signal to follow, e.g. \"ctrl.out\""),
+        ParamDecl::number("tau", "s", "time constant").positive(),
+        ParamDecl::number("y0", "", "initial output").default(0.0),
+    ],
+    |p| {
+        Ok(Box::new(Lag::new(
+            &p.signal("input")?,
+            p.number("tau")?,
+            p.number("y0")?,
+        )?))
+    },
+)
+.example("input = \"t\", tau = 0.1");
 
 #[cfg(test)]
 mod tests {

@@ -15,6 +15,7 @@ use nalgebra::DMatrix;
 use crate::bond::PortCausality;
 use crate::element::{CausalRule, Element, Io, PortSpec, Ports, SignalSpec, Slot, Stage};
 use crate::error::ParamError;
+use crate::kind::{BuildError, KindDecl, ParamDecl, Params};
 use crate::local_jacobian::LocalJacobian;
 
 /// The modulus law: fill `t` (n₁×n₂) from time and the element's inputs.
@@ -171,6 +172,54 @@ impl Element for MatrixTransformer {
         }
         true
     }
+}
+
+/// Kind `MTF`: a modulated transformer, scalar (`m`) or matrix (`T`, e₁ = T·e₂).
+pub const KIND: KindDecl = KindDecl::element(
+    "MTF",
+    "modulated transformer: m = m(signals), or a matrix T(signals) with e1 = T·e2",
+    &[
+        ParamDecl::modulated("m", "", "scalar modulus (may read signals)")
+            .optional("give `m` or `T`"),
+        ParamDecl::matrix("T", "", "modulus matrix, rows of expressions (e1 = T·e2)")
+            .optional("give `m` or `T`"),
+    ],
+    build,
+)
+.example("m = \"1 + 0.1*t\"");
+
+fn build(p: &dyn Params) -> Result<Box<dyn Element>, BuildError> {
+    if !p.has("T") {
+        if !p.has("m") {
+            return Err(BuildError::missing(
+                "m",
+                "needs `m` (scalar modulus) or `T` (matrix)",
+            ));
+        }
+        return Ok(Box::new(crate::Transformer::new(p.modulated("m")?)?));
+    }
+    if p.has("m") {
+        return Err(BuildError::conflict(
+            "m",
+            "give either `m` (scalar) or `T` (matrix), not both",
+        ));
+    }
+    let t = p.matrix("T")?;
+    let (n1, n2, n_in) = (t.rows, t.cols, t.inputs.len());
+    let specs = t.inputs.iter().map(|n| SignalSpec::scalar(n)).collect();
+    let entries = t.entries;
+    let law = Box::new(move |io: &Io<'_>, m: &mut nalgebra::DMatrix<f64>| {
+        let mut u = [0.0; crate::element::MAX_PARAM_INPUTS];
+        for (k, v) in u.iter_mut().take(n_in).enumerate() {
+            *v = io.u(k);
+        }
+        for i in 0..n1 {
+            for j in 0..n2 {
+                m[(i, j)] = entries[i * n2 + j](&u[..n_in]);
+            }
+        }
+    });
+    Ok(Box::new(MatrixTransformer::new(n1, n2, specs, law)?))
 }
 
 #[cfg(test)]

@@ -16,17 +16,17 @@
 //! | `p_control` | [`PController`] | y = clamp(K·(r − u), lo, hi) |
 //! | `signal` | [`SignalFunction`] | y = g(t, signals) |
 
-mod capacitor;
-mod gyrator;
-mod inertia;
-mod junction;
-mod lag;
-mod matrix_transformer;
-mod p_controller;
-mod resistor;
-mod signal_function;
-mod sources;
-mod transformer;
+pub(crate) mod capacitor;
+pub(crate) mod gyrator;
+pub(crate) mod inertia;
+pub(crate) mod junction;
+pub(crate) mod lag;
+pub(crate) mod matrix_transformer;
+pub(crate) mod p_controller;
+pub(crate) mod resistor;
+pub(crate) mod signal_function;
+pub(crate) mod sources;
+pub(crate) mod transformer;
 
 pub use capacitor::Capacitor;
 pub use gyrator::Gyrator;

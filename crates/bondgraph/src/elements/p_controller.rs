@@ -5,6 +5,7 @@
 
 use crate::element::{CausalRule, Element, Io, Param, Ports, SignalSpec, Slot};
 use crate::error::ParamError;
+use crate::kind::{KindDecl, ParamDecl};
 use crate::local_jacobian::LocalJacobian;
 
 /// P-controller with gain `gain`, set-point `setpoint` (may be modulated) and output limits.
@@ -84,6 +85,29 @@ impl Element for PController {
         true
     }
 }
+
+/// Kind `p_control`: `out = clamp(−gain·(input − setpoint), min, max)`.
+pub const KIND: KindDecl = KindDecl::element(
+    "p_control",
+    "P-controller: out = clamp(−gain·(input − setpoint), min, max)",
+    &[
+        ParamDecl::signal("input", "", "measured signal, e.g. \"cyl_piston.l\""),
+        ParamDecl::number("gain", "", "proportional gain"),
+        ParamDecl::modulated("setpoint", "", "set-point (may read signals and t)"),
+        ParamDecl::number("min", "", "lower limit of the output").default(f64::NEG_INFINITY),
+        ParamDecl::number("max", "", "upper limit of the output").default(f64::INFINITY),
+    ],
+    |p| {
+        Ok(Box::new(PController::new(
+            &p.signal("input")?,
+            p.number("gain")?,
+            p.modulated("setpoint")?,
+            p.number("min")?,
+            p.number("max")?,
+        )?))
+    },
+)
+.example("input = \"t\", gain = 2.0, setpoint = 1.0, min = -1, max = 1");
 
 #[cfg(test)]
 mod tests {

@@ -7,6 +7,7 @@
 use crate::bond::PortCausality;
 use crate::element::{CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Slot};
 use crate::error::ParamError;
+use crate::kind::{KindDecl, ParamDecl};
 use crate::local_jacobian::LocalJacobian;
 
 /// Linear (or modulated) resistor. Resistance `r` in effort/flow units (Ω, N·s/m, Pa·s/m³).
@@ -79,6 +80,15 @@ impl Element for Resistor {
         true
     }
 }
+
+/// Kind `R`: `e = r·f`.
+pub const KIND: KindDecl = KindDecl::element(
+    "R",
+    "resistor: e = r·f",
+    &[ParamDecl::modulated("r", "", "resistance e/f (may read signals)").non_negative()],
+    |p| Ok(Box::new(Resistor::new(p.modulated("r")?)?)),
+)
+.example("r = 2.0");
 
 #[cfg(test)]
 mod tests {

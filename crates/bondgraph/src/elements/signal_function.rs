@@ -2,6 +2,7 @@
 //! combination, a gain).
 
 use crate::element::{CausalRule, Element, Io, Param, Ports, SignalSpec, Slot};
+use crate::kind::{KindDecl, ParamDecl};
 use crate::local_jacobian::LocalJacobian;
 
 /// A signal block computing one scalar output from time and scalar signals.
@@ -46,6 +47,19 @@ impl Element for SignalFunction {
         true
     }
 }
+
+/// Kind `signal`: `out = value(t, parameters, signals)`.
+pub const KIND: KindDecl = KindDecl::element(
+    "signal",
+    "signal block: out = value(t, parameters, signals)",
+    &[ParamDecl::modulated(
+        "value",
+        "",
+        "expression of t, parameters and signals",
+    )],
+    |p| Ok(Box::new(SignalFunction::new(p.modulated("value")?))),
+)
+.example("value = \"sin(t)\"");
 
 #[cfg(test)]
 mod tests {

@@ -6,6 +6,7 @@
 
 use crate::bond::PortCausality as Pc;
 use crate::element::{CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Slot, Stage};
+use crate::kind::{KindDecl, ParamDecl};
 use crate::local_jacobian::LocalJacobian;
 
 /// Effort source `Se`: e = e_s(t, signals) on every component.
@@ -105,6 +106,32 @@ impl Element for FlowSource {
         true
     }
 }
+
+/// Kind `Se`: `e = e(t, signals)`.
+pub const SE: KindDecl = KindDecl::element(
+    "Se",
+    "effort source: e = e(t, signals)",
+    &[ParamDecl::modulated(
+        "e",
+        "",
+        "effort imposed (may read signals and t)",
+    )],
+    |p| Ok(Box::new(EffortSource::new(p.modulated("e")?))),
+)
+.example("e = 1.0");
+
+/// Kind `Sf`: `f = f(t, signals)`.
+pub const SF: KindDecl = KindDecl::element(
+    "Sf",
+    "flow source: delivers f = f(t, signals)",
+    &[ParamDecl::modulated(
+        "f",
+        "",
+        "flow delivered (may read signals and t)",
+    )],
+    |p| Ok(Box::new(FlowSource::new(p.modulated("f")?))),
+)
+.example("f = 1.0");
 
 #[cfg(test)]
 mod tests {

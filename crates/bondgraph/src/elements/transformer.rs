@@ -8,6 +8,7 @@
 use crate::bond::PortCausality;
 use crate::element::{CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Slot, Stage};
 use crate::error::ParamError;
+use crate::kind::{KindDecl, ParamDecl};
 use crate::local_jacobian::LocalJacobian;
 
 /// Transformer with (possibly modulated) modulus `m` (dimensionless or with units e₁/e₂).
@@ -116,6 +117,15 @@ impl Element for Transformer {
         true
     }
 }
+
+/// Kind `TF`: `e₁ = m·e₂`, `f₂ = m·f₁`.
+pub const KIND: KindDecl = KindDecl::element(
+    "TF",
+    "transformer: e1 = m·e2, f2 = m·f1",
+    &[ParamDecl::number("m", "", "modulus e1/e2 = f2/f1")],
+    |p| Ok(Box::new(Transformer::new(p.number("m")?)?)),
+)
+.example("m = 0.5");
 
 #[cfg(test)]
 mod tests {

@@ -3,6 +3,7 @@
 //! without an end stop.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+#[path = "hydraulics_common/mod.rs"]
 mod common;
 
 use bg_hydraulics::reg_root;

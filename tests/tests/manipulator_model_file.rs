@@ -7,7 +7,7 @@ use bg_model::{Model, Registry};
 
 fn registry() -> Registry {
     let mut r = Registry::with_core();
-    bg_manipulator::register(&mut r);
+    r.add(bg_manipulator::KINDS);
     r
 }
 

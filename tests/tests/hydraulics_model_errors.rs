@@ -2,6 +2,7 @@
 //! never a panic.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+#[path = "hydraulics_common/mod.rs"]
 mod common;
 
 use bg_model::{ErrorKind, Model};
@@ -60,8 +61,15 @@ fn geometry_is_checked_with_the_key_named() {
 
 #[test]
 fn unknown_cylinder_parameter_is_reported() {
+    // Unknown keys are reported first, with the declared key they look like.
     let e = lift_with(r#"k_stop = 1e9"#, "k_stopp = 1e9").unwrap_err();
-    assert_eq!(e.kind, ErrorKind::BadParameter, "{e}");
+    assert_eq!(e.kind, ErrorKind::ExtraParameter, "{e}");
+    assert!(
+        e.hint
+            .as_deref()
+            .is_some_and(|h| h.contains("did you mean `k_stop`")),
+        "{e}"
+    );
     let e = lift_with(r#"k_stop = 1e9, c_stop = 5e6"#, "c_stopp = 5e6").unwrap_err();
     assert_eq!(e.kind, ErrorKind::ExtraParameter, "{e}");
 }

@@ -1,0 +1,340 @@
+//! Model-file support: the composite kind `manipulator.planar_arm`, which builds an
+//! [`ArmScene`] from one `[elements.<name>]` table.
+//!
+//! ```toml
+//! [elements.crane]
+//! kind = "manipulator.planar_arm"
+//! gravity = "g"                       # m/s² along −y₀ (default 9.81)
+//! q0 = [0, "-2*pi/3", "pi/6"]         # joint angles, then modal coordinates (missing: 0)
+//! u0 = []                             # speeds (missing: 0)
+//! damping = [0, 0, "r_p", "r_e", "r_e", "r_e", "r_e", "r_e", "r_e"]   # diag D (missing: 0)
+//! quadrature_points = 16              # Gauss–Legendre points per link (reference; non-sine modes)
+//! links = [
+//!   { type = "beam", length = "L1", E = "E", rho = "rho", A = "A", I = "I", modes = 3 },
+//!   { type = "beam", length = "L2", E = "E", rho = "rho", A = "A", I = "I", modes = 3 },
+//!   { type = "pendulum", length = "L3", mass = "m3" },
+//! ]
+//! actuators = [                       # pins: { ground = [x, y] } or { link = 1, x = … }
+//!   { from = { ground = ["d0*cos(beta3)", "-d0*sin(beta3)"] }, to = { link = 1, x = "h1" } },
+//!   { from = { link = 1, x = "L1 - h2" }, to = { link = 2, x = "h3" } },
+//! ]
+//! lumped_masses = [{ link = 1, x = "h1", mass = "m_p" }, …]
+//! lumped_model = "springs"            # "springs" (default), "rigid" or "none"
+//! lumped_stiffness = "k_c"            # N/m, with "springs"
+//! lumped_damping = "c_c"              # N·s/m, with "springs"
+//! paper_reactions = false             # also publish rho{k}_paper (springs only)
+//! ```
+//!
+//! Links are numbered from 1 as in the paper. A link table has `type` = `"beam"` (length, E,
+//! rho, A, I, modes), `"rigid"` (length, mass_per_length, rotary_inertia_per_length) or
+//! `"pendulum"` (length, mass), and may list `point_masses = [{ x, mass, inertia }]`. All
+//! numbers may be expressions of the model's parameters; events that change a parameter the
+//! arm uses (damping) rebuild its members. Every key is declared in [`PLANAR_ARM`]'s tables.
+
+use bondgraph::kind::{BuildError, KindDecl, ParamDecl, Params, Range};
+use bondgraph::{Composite, ParamError};
+
+use crate::actuator::LinearActuator;
+use crate::link::{Link, PointMass};
+use crate::lumped_mass::LumpedMass;
+use crate::pin::Pin;
+use crate::quadrature::GaussLegendre;
+use crate::scene::{ArmScene, LumpedMassModel};
+
+/// Every kind of this crate.
+pub const KINDS: &[KindDecl] = &[PLANAR_ARM];
+
+const POINT_MASS: &[ParamDecl] = &[
+    ParamDecl::number("x", "m", "position along the link"),
+    ParamDecl::number("mass", "kg", "mass").non_negative(),
+    ParamDecl::number("inertia", "kg·m²", "rotary inertia about its centre")
+        .non_negative()
+        .default(0.0),
+];
+
+const LINK: &[ParamDecl] = &[
+    ParamDecl::choice(
+        "type",
+        &["beam", "rigid", "pendulum"],
+        "beam",
+        "flexible beam, rigid link, or massless rod with a tip mass",
+    ),
+    ParamDecl::number("length", "m", "link length").positive(),
+    ParamDecl::number("E", "Pa", "Young's modulus (beam)")
+        .positive()
+        .optional("beam only"),
+    ParamDecl::number("rho", "kg/m³", "density (beam)")
+        .positive()
+        .optional("beam only"),
+    ParamDecl::number("A", "m²", "cross-section area (beam)")
+        .positive()
+        .optional("beam only"),
+    ParamDecl::number("I", "m⁴", "second moment of area (beam)")
+        .positive()
+        .optional("beam only"),
+    ParamDecl::count("modes", "assumed modes (beam)")
+        .range(Range::closed(0.0, 64.0))
+        .default(0.0),
+    ParamDecl::number("mass_per_length", "kg/m", "mass per length (rigid)")
+        .non_negative()
+        .default(0.0),
+    ParamDecl::number(
+        "rotary_inertia_per_length",
+        "kg·m",
+        "rotary inertia per length (rigid)",
+    )
+    .non_negative()
+    .default(0.0),
+    ParamDecl::number("mass", "kg", "tip mass (pendulum)")
+        .non_negative()
+        .optional("pendulum only"),
+    ParamDecl::tables("point_masses", POINT_MASS, "point masses on the link").optional("none"),
+];
+
+const PIN: &[ParamDecl] = &[
+    ParamDecl::vector("ground", "m", "a pin on the ground at [x, y]").optional("a pin on a link"),
+    ParamDecl::count("link", "the link the pin is on, 1, 2, …")
+        .range(Range::at_least(1.0))
+        .optional("on the ground"),
+    ParamDecl::number("x", "m", "position along that link").optional("on the ground"),
+];
+
+const ACTUATOR: &[ParamDecl] = &[
+    ParamDecl::table("from", PIN, "the pin the actuator pushes from"),
+    ParamDecl::table("to", PIN, "the pin it pushes"),
+];
+
+const LUMPED_MASS: &[ParamDecl] = &[
+    ParamDecl::count("link", "the link it sits on, 1, 2, …").range(Range::at_least(1.0)),
+    ParamDecl::number("x", "m", "position along that link"),
+    ParamDecl::number("mass", "kg", "mass").positive(),
+];
+
+/// Kind `manipulator.planar_arm`.
+pub const PLANAR_ARM: KindDecl = KindDecl::composite(
+    "manipulator.planar_arm",
+    "planar serial arm of rigid/flexible links (assumed modes), actuators and lumped masses, with reaction forces; ports cyl1.., u",
+    &[
+        ParamDecl::tables("links", LINK, "the links from the base, numbered 1, 2, …"),
+        ParamDecl::number("gravity", "m/s²", "gravity along −y₀").default(9.81),
+        ParamDecl::count("quadrature_points", "Gauss–Legendre points per link (reference; non-sine modes)")
+            .range(Range::closed(1.0, 512.0))
+            .default(GaussLegendre::DEFAULT_POINTS as f64),
+        ParamDecl::vector("q0", "", "initial joint angles (rad), then modal coordinates; missing: 0").optional("0"),
+        ParamDecl::vector("u0", "", "initial speeds; missing: 0").optional("0"),
+        ParamDecl::vector("damping", "", "diagonal of D, one per coordinate; missing: 0").optional("0"),
+        ParamDecl::vector("joint_damping", "N·m·s", "damping of each joint, instead of `damping`").optional("0"),
+        ParamDecl::vector("modal_damping", "", "damping of every modal coordinate (one value, or one per link)").optional("0"),
+        ParamDecl::tables("actuators", ACTUATOR, "linear actuators between two pins").optional("none"),
+        ParamDecl::tables("lumped_masses", LUMPED_MASS, "lumped masses on the links (cylinder bodies)").optional("none"),
+        ParamDecl::choice("lumped_model", &["springs", "rigid", "none"], "springs", "how lumped masses attach"),
+        ParamDecl::number("lumped_stiffness", "N/m", "spring stiffness of lumped masses (with \"springs\")").positive().optional("needed with springs"),
+        ParamDecl::number("lumped_damping", "N·s/m", "spring damping of lumped masses (with \"springs\")").non_negative().default(0.0),
+        ParamDecl::flag("paper_reactions", false, "also publish rho{k}_paper (springs only)"),
+    ],
+    build_planar_arm,
+)
+.example("links = [{ type = \"beam\", length = 1.0, E = 2e11, rho = 7800, A = 1e-3, I = 1e-6, modes = 1 }], q0 = [0.1]");
+
+fn build_planar_arm(p: &dyn Params) -> Result<Composite, BuildError> {
+    Ok(scene(p)?.composite(p.name())?)
+}
+
+fn within(prefix: String) -> impl Fn(ParamError) -> BuildError {
+    move |e| BuildError::from(e).within(&prefix)
+}
+
+fn link(k: usize, t: &dyn Params) -> Result<Link, BuildError> {
+    let fail = || within(format!("links[{}]", k + 1));
+    let length = t.number("length")?;
+    let kind = t.word("type")?;
+    let only = |keys: &[&str], what: &str| -> Result<(), BuildError> {
+        match keys.iter().find(|key| t.has(key)) {
+            Some(key) => Err(BuildError::conflict(
+                key,
+                format!("`{key}` does not apply to a {what} link"),
+            )
+            .within(&format!("links[{}]", k + 1))),
+            None => Ok(()),
+        }
+    };
+    let mut l = match kind.as_str() {
+        "rigid" => {
+            only(&["E", "rho", "A", "I", "modes", "mass"], "rigid")?;
+            let (m, j) = (
+                t.number("mass_per_length")?,
+                t.number("rotary_inertia_per_length")?,
+            );
+            Link::rigid(length, m)
+                .and_then(|l| l.with_rotary_inertia(j))
+                .map_err(fail())?
+        }
+        "pendulum" => {
+            only(
+                &[
+                    "E",
+                    "rho",
+                    "A",
+                    "I",
+                    "modes",
+                    "mass_per_length",
+                    "rotary_inertia_per_length",
+                ],
+                "pendulum",
+            )?;
+            Link::pendulum(length, t.number("mass")?).map_err(fail())?
+        }
+        _ => {
+            only(
+                &["mass", "mass_per_length", "rotary_inertia_per_length"],
+                "beam",
+            )?;
+            let beam = Link::beam(
+                length,
+                t.number("E")?,
+                t.number("rho")?,
+                t.number("A")?,
+                t.number("I")?,
+            )
+            .map_err(fail())?;
+            beam.with_sine_modes(t.count("modes")? as u32)
+                .map_err(fail())?
+        }
+    };
+    for m in t.tables("point_masses")? {
+        let mass = PointMass {
+            x: m.number("x")?,
+            mass: m.number("mass")?,
+            inertia: m.number("inertia")?,
+        };
+        l = l.with_point_mass(mass).map_err(fail())?;
+    }
+    Ok(l)
+}
+
+fn pin(t: &dyn Params, at: &str) -> Result<Pin, BuildError> {
+    if t.has("ground") {
+        if let Some(k) = ["link", "x"].into_iter().find(|k| t.has(k)) {
+            return Err(BuildError::conflict(
+                k,
+                "a pin is either on the ground (`ground = [x, y]`) or on a link (`link`, `x`)",
+            )
+            .within(at));
+        }
+        let xy = t.vector("ground")?;
+        let [x, y] = xy[..] else {
+            return Err(BuildError::invalid("ground", "`ground` must be [x, y]").within(at));
+        };
+        return Ok(Pin::ground(x, y));
+    }
+    if !t.has("link") {
+        return Err(BuildError::missing(
+            "link",
+            "a pin needs `ground = [x, y]`, or `link` and `x`",
+        )
+        .within(at));
+    }
+    Ok(Pin::on_link(t.count("link")? - 1, t.number("x")?))
+}
+
+fn scene(p: &dyn Params) -> Result<ArmScene, BuildError> {
+    let links = p
+        .tables("links")?
+        .iter()
+        .enumerate()
+        .map(|(k, t)| link(k, t.as_ref()))
+        .collect::<Result<Vec<_>, _>>()?;
+    if links.is_empty() {
+        return Err(BuildError::missing(
+            "links",
+            "needs `links = [ … ]` with at least one link",
+        ));
+    }
+    let mut scene = ArmScene::new(links, p.number("gravity")?);
+    scene.quadrature_points = p.count("quadrature_points")?;
+    scene.q0 = p.vector("q0")?;
+    scene.u0 = p.vector("u0")?;
+    scene.damping = p.vector("damping")?;
+    // Damping by kind, independent of the number of modes: one value per joint and one for
+    // every modal coordinate (or one per link).
+    if p.has("joint_damping") || p.has("modal_damping") {
+        if !scene.damping.is_empty() {
+            return Err(BuildError::conflict("damping", "give either `damping` (one entry per coordinate) or `joint_damping` and `modal_damping`, not both"));
+        }
+        let n_links = scene.links.len();
+        let joints = if p.has("joint_damping") {
+            p.vector("joint_damping")?
+        } else {
+            vec![0.0; n_links]
+        };
+        if joints.len() != n_links {
+            return Err(BuildError::invalid(
+                "joint_damping",
+                format!(
+                    "`joint_damping` needs one value per joint ({n_links}), got {}",
+                    joints.len()
+                ),
+            ));
+        }
+        let modal = if p.has("modal_damping") {
+            p.vector("modal_damping")?
+        } else {
+            vec![0.0]
+        };
+        if modal.len() != 1 && modal.len() != n_links {
+            return Err(BuildError::invalid(
+                "modal_damping",
+                format!(
+                    "`modal_damping` needs one value, or one per link ({n_links}), got {}",
+                    modal.len()
+                ),
+            ));
+        }
+        let mut d = joints;
+        for (i, l) in scene.links.iter().enumerate() {
+            let r = if modal.len() == 1 { modal[0] } else { modal[i] };
+            d.extend(std::iter::repeat_n(r, l.modes().len()));
+        }
+        scene.damping = d;
+    }
+    for (k, t) in p.tables("actuators")?.iter().enumerate() {
+        let at = |e: &str| format!("actuators[{}].{e}", k + 1);
+        let (Some(from), Some(to)) = (t.table("from")?, t.table("to")?) else {
+            return Err(BuildError::missing(
+                "actuators",
+                format!("`actuators[{}]` needs `from` and `to`", k + 1),
+            ));
+        };
+        scene.actuators.push(LinearActuator::new(
+            pin(from.as_ref(), &at("from"))?,
+            pin(to.as_ref(), &at("to"))?,
+        ));
+    }
+    for t in p.tables("lumped_masses")? {
+        scene.lumped_masses.push(LumpedMass {
+            pin: Pin::on_link(t.count("link")? - 1, t.number("x")?),
+            mass: t.number("mass")?,
+        });
+    }
+    scene.paper_reactions = p.flag("paper_reactions")?;
+    // The spring parameters are read whatever the model, so that `--set` can switch
+    // `lumped_model` alone.
+    let stiffness = p.optional("lumped_stiffness")?;
+    let damping = p.number("lumped_damping")?;
+    scene.lumped_model = match p.word("lumped_model")?.as_str() {
+        "rigid" => LumpedMassModel::Rigid,
+        "none" => LumpedMassModel::Omitted,
+        _ if scene.lumped_masses.is_empty() => LumpedMassModel::Omitted,
+        _ => match stiffness {
+            Some(stiffness) => LumpedMassModel::Springs { stiffness, damping },
+            None => {
+                return Err(BuildError::missing(
+                    "lumped_stiffness",
+                    "lumped masses on springs need `lumped_stiffness` (N/m)",
+                )
+                .hint("give `lumped_stiffness`, or `lumped_model = \"rigid\"` or \"none\""))
+            }
+        },
+    };
+    Ok(scene)
+}

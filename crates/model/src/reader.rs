@@ -1,0 +1,680 @@
+//! [`ElementSpec`]: one model-file entry's parameters, read by their kind's declarations
+//! ([`bondgraph::kind`]). It is the loader's side of [`Params`]: defaults and ranges come
+//! from the [`ParamDecl`]s, expressions are evaluated against the model's `[parameters]`,
+//! values may carry a unit (`"200 bar"`), and every problem becomes a [`BuildError`] naming
+//! the parameter, which [`ElementSpec::locate`] turns into a [`ModelError`] at its line.
+
+use std::cell::RefCell;
+use std::collections::HashSet;
+use std::ops::Range;
+
+use bondgraph::kind::{
+    self, units, BuildError, BuildErrorKind, Default, MatrixParam, ParamDecl, ParamType, Params,
+};
+use bondgraph::Param;
+use indexmap::IndexMap;
+
+use crate::error::{clip, line_col, ErrorKind, ModelError};
+use crate::expr::{Compiled, Expr};
+
+/// A parameter value as written in the file, with its byte span.
+#[derive(Clone, Debug)]
+pub struct RawValue {
+    /// The TOML value.
+    pub value: toml::Value,
+    /// Byte range in the file.
+    pub span: Range<usize>,
+}
+
+/// One entry's parameters as its builder sees them (see the module documentation).
+pub struct ElementSpec<'a> {
+    /// Element name.
+    pub name: &'a str,
+    /// Element kind.
+    pub kind: &'a str,
+    pub(crate) decls: &'static [ParamDecl],
+    pub(crate) params: IndexMap<String, RawValue>,
+    pub(crate) constants: &'a IndexMap<String, f64>,
+    pub(crate) file: &'a str,
+    pub(crate) text: &'a str,
+    pub(crate) name_span: Range<usize>,
+    /// Where a nested table sits (`links[2]`); empty at the top.
+    pub(crate) path: String,
+    pub(crate) used_constants: &'a RefCell<HashSet<String>>,
+}
+
+fn kind_of(e: &BuildError) -> ErrorKind {
+    match e.kind {
+        BuildErrorKind::Missing => ErrorKind::MissingParameter,
+        BuildErrorKind::Unknown => ErrorKind::ExtraParameter,
+        _ => ErrorKind::BadParameter,
+    }
+}
+
+impl<'a> ElementSpec<'a> {
+    /// The entry's parameters (top level), before they are checked against `decls`.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn new(
+        name: &'a str,
+        kind: &'a str,
+        decls: &'static [ParamDecl],
+        params: IndexMap<String, RawValue>,
+        constants: &'a IndexMap<String, f64>,
+        file: &'a str,
+        text: &'a str,
+        name_span: Range<usize>,
+        used_constants: &'a RefCell<HashSet<String>>,
+    ) -> Self {
+        Self {
+            name,
+            kind,
+            decls,
+            params,
+            constants,
+            file,
+            text,
+            name_span,
+            path: String::new(),
+            used_constants,
+        }
+    }
+
+    /// `key` with this table's place in front (`links[2].length`).
+    fn full(&self, key: &str) -> String {
+        if self.path.is_empty() {
+            key.to_owned()
+        } else {
+            format!("{}.{key}", self.path)
+        }
+    }
+
+    /// An error about `key`; inside a nested table the message names the key by its path
+    /// (`links[3].type`).
+    fn err(&self, kind: BuildErrorKind, key: &str, message: impl Into<String>) -> BuildError {
+        let full = self.full(key);
+        let mut message = message.into();
+        if !self.path.is_empty() {
+            message = message.replace(&format!("`{key}`"), &format!("`{full}`"));
+        }
+        BuildError::new(kind, Some(&full), message)
+    }
+
+    fn decl(&self, key: &str) -> Result<&'static ParamDecl, BuildError> {
+        self.decls.iter().find(|d| d.name == key).ok_or_else(|| {
+            self.err(
+                BuildErrorKind::Undeclared,
+                key,
+                format!(
+                    "the builder of `{}` reads `{key}`, which the kind does not declare",
+                    self.kind
+                ),
+            )
+            .hint("this is a bug in the element kind: declare the parameter in its table")
+        })
+    }
+
+    /// Check the given keys against the declarations: unknown keys (with a suggestion),
+    /// required keys, and every given value's type and range.
+    pub(crate) fn validate(&self) -> Result<(), BuildError> {
+        let declared = || self.decls.iter().map(|d| d.name);
+        for key in self.params.keys() {
+            if self.decls.iter().any(|d| d.name == key) {
+                continue;
+            }
+            let takes = if self.decls.is_empty() {
+                "it takes none".to_owned()
+            } else {
+                format!("it takes: {}", declared().collect::<Vec<_>>().join(", "))
+            };
+            let hint =
+                match kind::suggest(key, declared().filter(|d| !self.params.contains_key(*d))) {
+                    Some(s) => format!("did you mean `{s}`? {takes}"),
+                    None => takes,
+                };
+            let message = if self.path.is_empty() {
+                format!("has no parameter `{}`", clip(key))
+            } else {
+                format!("`{}` has an unknown key `{}`", self.path, clip(key))
+            };
+            return Err(
+                BuildError::new(BuildErrorKind::Unknown, Some(&self.full(key)), message).hint(hint),
+            );
+        }
+        for d in self.decls {
+            if d.required() && !self.params.contains_key(d.name) {
+                return Err(self.missing(d));
+            }
+        }
+        for key in self.params.keys() {
+            let d = self.decl(key)?;
+            match d.ty {
+                ParamType::Number => self.number(key).map(drop)?,
+                ParamType::Modulated => self.modulated(key).map(drop)?,
+                ParamType::Count => self.count(key).map(drop)?,
+                ParamType::Signal => self.signal(key).map(drop)?,
+                ParamType::Flag => self.flag(key).map(drop)?,
+                ParamType::Choice(_) => self.word(key).map(drop)?,
+                ParamType::Vector => self.vector(key).map(drop)?,
+                ParamType::Matrix | ParamType::Table(_) | ParamType::Tables(_) => {}
+            }
+        }
+        Ok(())
+    }
+
+    fn missing(&self, d: &ParamDecl) -> BuildError {
+        let unit = if d.unit.is_empty() || d.unit == "1" {
+            String::new()
+        } else {
+            format!(", {}", d.unit)
+        };
+        let what = format!("{}{unit}", d.doc);
+        // A given key nobody declared that looks like this one is probably a misspelling.
+        if let Some(t) = self
+            .params
+            .keys()
+            .find(|k| !self.decls.iter().any(|d| d.name == k.as_str()) && kind::similar(k, d.name))
+        {
+            return self
+                .err(
+                    BuildErrorKind::Missing,
+                    t,
+                    format!(
+                        "needs parameter `{}` ({what}); it has `{t}` instead",
+                        d.name
+                    ),
+                )
+                .hint(format!(
+                    "did you mean `{}`? rename `{t}` to `{}`",
+                    d.name, d.name
+                ));
+        }
+        self.err(
+            BuildErrorKind::Missing,
+            d.name,
+            format!("needs parameter `{}` ({what})", d.name),
+        )
+        .hint(format!("add `{} = …` to element `{}`", d.name, self.name))
+    }
+
+    /// Parse a value as an expression, with its unit converted to the declared one.
+    fn expr(&self, d: &ParamDecl, value: &toml::Value) -> Result<Expr, BuildError> {
+        let key = d.name;
+        match value {
+            toml::Value::Float(v) => Ok(Expr::Num(*v)),
+            toml::Value::Integer(i) => Ok(Expr::Num(*i as f64)),
+            toml::Value::String(s) => {
+                if let Some((body, unit)) = units::split_value(s) {
+                    if let Ok(e) = Expr::parse(body) {
+                        let Some(want) = units::parse(d.unit) else {
+                            return Err(self.err(BuildErrorKind::WrongUnit, key, format!("`{key}` is given with a unit, but its unit `{}` cannot be converted", d.unit))
+                                .hint(format!("write `{key}` as a number in {}", d.unit)));
+                        };
+                        if want.dim != unit.dim {
+                            return Err(self
+                                .err(
+                                    BuildErrorKind::WrongUnit,
+                                    key,
+                                    format!(
+                                        "`{key}` is a {} ({}), but \"{}\" is a {}",
+                                        units::describe(want.dim),
+                                        d.unit,
+                                        clip(s),
+                                        units::describe(unit.dim)
+                                    ),
+                                )
+                                .hint(format!(
+                                    "give `{key}` in {} or a unit of the same kind",
+                                    d.unit
+                                )));
+                        }
+                        let scale = unit.scale / want.scale;
+                        return Ok(Expr::Bin('*', Box::new(Expr::Num(scale)), Box::new(e)));
+                    }
+                }
+                Expr::parse(s).map_err(|e| {
+                    self.err(BuildErrorKind::Invalid, key, format!("cannot read `{key}` = \"{}\": {e}", clip(s)))
+                        .hint("expressions use numbers, parameters, signals like `spring.q`, `t`, + - * / ^ and functions such as sqrt, sin, exp, min, max; a unit may follow after a space (\"200 bar\")")
+                })
+            }
+            other => Err(self.err(
+                BuildErrorKind::Invalid,
+                key,
+                format!(
+                    "`{key}` must be a number or an expression string, not {}",
+                    other.type_str()
+                ),
+            )),
+        }
+    }
+
+    fn note_constants(&self, e: &Expr) {
+        for n in e.names() {
+            if self.constants.contains_key(&n) {
+                self.used_constants.borrow_mut().insert(n);
+            }
+        }
+    }
+
+    fn constant(&self, d: &ParamDecl, e: &Expr) -> Result<f64, BuildError> {
+        let key = d.name;
+        self.note_constants(e);
+        let v = e.eval(&|n| self.constants.get(n).copied()).map_err(|m| {
+            self.err(BuildErrorKind::Invalid, key, format!("`{key}`: {m}"))
+                .hint(format!(
+                    "`{key}` must be constant: use numbers and names from [parameters] ({})",
+                    clip(
+                        &self
+                            .constants
+                            .keys()
+                            .cloned()
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )
+                ))
+        })?;
+        self.in_range(d, v)
+    }
+
+    fn in_range(&self, d: &ParamDecl, v: f64) -> Result<f64, BuildError> {
+        if d.range.contains(v) {
+            return Ok(v);
+        }
+        let unit = if d.unit.is_empty() || d.unit == "1" {
+            String::new()
+        } else {
+            format!(" {}", d.unit)
+        };
+        Err(self
+            .err(
+                BuildErrorKind::Invalid,
+                d.name,
+                format!(
+                    "`{}` = {v} is out of range: it must be {}{unit}",
+                    d.name, d.range
+                ),
+            )
+            .hint(format!("`{}` is the {}", d.name, d.doc)))
+    }
+
+    fn raw(&self, key: &str) -> Option<&toml::Value> {
+        self.params.get(key).map(|r| &r.value)
+    }
+
+    /// Compile an expression: model parameters become constants, other names signal inputs.
+    fn compile(&self, key: &str, e: &Expr) -> Result<(Compiled, Vec<String>), BuildError> {
+        let mut inputs = Vec::new();
+        for n in e.names() {
+            if n == "pi" {
+                continue;
+            }
+            if self.constants.contains_key(&n) {
+                self.used_constants.borrow_mut().insert(n);
+            } else if n == "t" || n == "time" || n.contains('.') {
+                if !inputs.contains(&n) {
+                    inputs.push(n);
+                }
+            } else {
+                return Err(self
+                    .err(BuildErrorKind::Invalid, key, format!("`{key}` uses `{n}`, which is neither a parameter nor a signal"))
+                    .hint(format!("define `{n}` in [parameters], or name a signal as `<element>.<variable>`; parameters: {}", clip(&self.constants.keys().cloned().collect::<Vec<_>>().join(", ")))));
+            }
+        }
+        let max = bondgraph::element::MAX_PARAM_INPUTS;
+        if inputs.len() > max {
+            return Err(self.err(
+                BuildErrorKind::Invalid,
+                key,
+                format!("`{key}` reads {} signals; at most {max}", inputs.len()),
+            ));
+        }
+        let c = e
+            .compile(&|n| self.constants.get(n).copied(), &inputs)
+            .map_err(|m| self.err(BuildErrorKind::Invalid, key, m))?;
+        Ok((c, inputs))
+    }
+
+    fn default_number(&self, d: &ParamDecl) -> Result<Option<f64>, BuildError> {
+        match d.default {
+            Default::Value(v) => Ok(Some(v)),
+            Default::Optional(_) => Ok(None),
+            Default::Required => Err(self.missing(d)),
+            Default::Word(_) | Default::Flag(_) => Err(self.type_error(d)),
+        }
+    }
+
+    fn type_error(&self, d: &ParamDecl) -> BuildError {
+        self.err(
+            BuildErrorKind::Undeclared,
+            d.name,
+            format!(
+                "`{}` is declared as a {}, but read as another type",
+                d.name,
+                d.ty.describe()
+            ),
+        )
+        .hint("this is a bug in the element kind")
+    }
+
+    /// A nested table's reader.
+    fn nested(
+        &self,
+        path: String,
+        fields: &'static [ParamDecl],
+        table: &toml::Table,
+        span: &Range<usize>,
+    ) -> Result<Box<dyn Params + '_>, BuildError> {
+        let params = table
+            .iter()
+            .map(|(k, v)| {
+                (
+                    k.clone(),
+                    RawValue {
+                        value: v.clone(),
+                        span: span.clone(),
+                    },
+                )
+            })
+            .collect();
+        let spec = ElementSpec {
+            name: self.name,
+            kind: self.kind,
+            decls: fields,
+            params,
+            constants: self.constants,
+            file: self.file,
+            text: self.text,
+            name_span: self.name_span.clone(),
+            path,
+            used_constants: self.used_constants,
+        };
+        spec.validate()?;
+        Ok(Box::new(spec))
+    }
+
+    /// A [`BuildError`] as a [`ModelError`] at the line of the parameter it names.
+    #[must_use]
+    pub fn locate(&self, e: BuildError) -> ModelError {
+        let key = e
+            .param
+            .as_deref()
+            .map(|p| p.split(['.', '[']).next().unwrap_or(p));
+        let span = key
+            .and_then(|k| self.params.get(k))
+            .map_or(self.name_span.start, |v| v.span.start);
+        let kind = kind_of(&e);
+        let mut m = ModelError::new(kind, self.file, format!("({}) {}", self.kind, e.message))
+            .at(Some(line_col(self.text, span)))
+            .element(self.name);
+        if let Some(h) = &e.hint {
+            m = m.hint(h.clone());
+        } else if let Some(d) = key.and_then(|k| self.decls.iter().find(|d| d.name == k)) {
+            let unit = if d.unit.is_empty() || d.unit == "1" {
+                String::new()
+            } else {
+                format!(", in {}", d.unit)
+            };
+            m = m.hint(format!(
+                "fix `{}` of `{}`: it is the {}{unit}",
+                d.name, self.name, d.doc
+            ));
+        }
+        m.with_source(e)
+    }
+}
+
+impl Params for ElementSpec<'_> {
+    fn name(&self) -> &str {
+        self.name
+    }
+    fn kind(&self) -> &str {
+        self.kind
+    }
+    fn has(&self, key: &str) -> bool {
+        self.params.contains_key(key)
+    }
+    fn number(&self, key: &str) -> Result<f64, BuildError> {
+        let d = self.decl(key)?;
+        match self.raw(key) {
+            None => self.default_number(d)?.ok_or_else(|| self.missing(d)),
+            Some(v) => {
+                let e = self.expr(d, v)?;
+                self.constant(d, &e)
+            }
+        }
+    }
+    fn optional(&self, key: &str) -> Result<Option<f64>, BuildError> {
+        let d = self.decl(key)?;
+        match self.raw(key) {
+            None => self.default_number(d),
+            Some(_) => self.number(key).map(Some),
+        }
+    }
+    fn modulated(&self, key: &str) -> Result<Param, BuildError> {
+        let d = self.decl(key)?;
+        let Some(v) = self.raw(key) else {
+            return self
+                .default_number(d)?
+                .map(Param::Const)
+                .ok_or_else(|| self.missing(d));
+        };
+        let e = self.expr(d, v)?;
+        let (compiled, inputs) = self.compile(key, &e)?;
+        if let Some(c) = compiled.constant() {
+            return self.in_range(d, c).map(Param::Const);
+        }
+        Ok(Param::modulated(inputs, move |_, u| compiled.eval(u)))
+    }
+    fn count(&self, key: &str) -> Result<usize, BuildError> {
+        let v = self.number(key)?;
+        if v.fract() != 0.0 || !(0.0..=1e9).contains(&v) {
+            return Err(self.err(
+                BuildErrorKind::Invalid,
+                key,
+                format!("`{key}` = {v} must be a whole number ≥ 0"),
+            ));
+        }
+        Ok(v as usize)
+    }
+    fn signal(&self, key: &str) -> Result<String, BuildError> {
+        let d = self.decl(key)?;
+        match self.raw(key) {
+            None => Err(self.missing(d)),
+            Some(toml::Value::String(s)) if !s.trim().is_empty() => Ok(s.trim().to_owned()),
+            Some(_) => Err(self.err(
+                BuildErrorKind::Invalid,
+                key,
+                format!("`{key}` must name a signal, e.g. \"spring.q\""),
+            )),
+        }
+    }
+    fn flag(&self, key: &str) -> Result<bool, BuildError> {
+        let d = self.decl(key)?;
+        match (self.raw(key), d.default) {
+            (Some(toml::Value::Boolean(b)), _) => Ok(*b),
+            (Some(_), _) => Err(self.err(
+                BuildErrorKind::Invalid,
+                key,
+                format!("`{key}` must be true or false"),
+            )),
+            (None, Default::Flag(b)) => Ok(b),
+            (None, _) => Err(self.missing(d)),
+        }
+    }
+    fn word(&self, key: &str) -> Result<String, BuildError> {
+        let d = self.decl(key)?;
+        let ParamType::Choice(choices) = d.ty else {
+            return Err(self.type_error(d));
+        };
+        match (self.raw(key), d.default) {
+            (Some(toml::Value::String(s)), _) if choices.contains(&s.as_str()) => Ok(s.clone()),
+            (Some(v), _) => {
+                let given = v
+                    .as_str()
+                    .map_or_else(|| v.type_str().to_owned(), |s| format!("\"{}\"", clip(s)));
+                let list = choices
+                    .iter()
+                    .map(|c| format!("\"{c}\""))
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                let hint = match v
+                    .as_str()
+                    .and_then(|s| kind::suggest(s, choices.iter().copied()))
+                {
+                    Some(c) => format!("did you mean \"{c}\"?"),
+                    None => format!("`{key}` is the {}", d.doc),
+                };
+                Err(self
+                    .err(
+                        BuildErrorKind::Invalid,
+                        key,
+                        format!("`{key}` must be one of {list}, not {given}"),
+                    )
+                    .hint(hint))
+            }
+            (None, Default::Word(w)) => Ok(w.to_owned()),
+            (None, _) => Err(self.missing(d)),
+        }
+    }
+    fn vector(&self, key: &str) -> Result<Vec<f64>, BuildError> {
+        let d = self.decl(key)?;
+        match self.raw(key) {
+            None => Ok(self.default_number(d)?.map_or_else(Vec::new, |v| vec![v])),
+            Some(toml::Value::Array(items)) => items
+                .iter()
+                .map(|v| {
+                    let e = self.expr(d, v)?;
+                    self.constant(d, &e)
+                })
+                .collect(),
+            Some(v) => {
+                let e = self.expr(d, v)?;
+                Ok(vec![self.constant(d, &e)?])
+            }
+        }
+    }
+    fn matrix(&self, key: &str) -> Result<MatrixParam, BuildError> {
+        let d = self.decl(key)?;
+        let raw = self.raw(key).ok_or_else(|| self.missing(d))?;
+        let shape_err = || {
+            self.err(
+                BuildErrorKind::Invalid,
+                key,
+                format!(
+                    "`{key}` must be an array of rows of equal length, e.g. [[1, 0], [0, \"x.q\"]]"
+                ),
+            )
+        };
+        let toml::Value::Array(rows) = raw else {
+            return Err(shape_err());
+        };
+        let mut exprs = Vec::new();
+        let mut cols = None;
+        for row in rows {
+            let toml::Value::Array(r) = row else {
+                return Err(shape_err());
+            };
+            if cols.is_some_and(|c| c != r.len()) || r.is_empty() {
+                return Err(shape_err());
+            }
+            cols = Some(r.len());
+            for v in r {
+                exprs.push(self.expr(d, v)?);
+            }
+        }
+        let (n1, n2) = (rows.len(), cols.unwrap_or(0));
+        if n1 == 0 {
+            return Err(shape_err());
+        }
+        let mut inputs: Vec<String> = Vec::new();
+        for e in &exprs {
+            for n in e.names() {
+                if !self.constants.contains_key(&n) && n != "pi" && !inputs.contains(&n) {
+                    inputs.push(n);
+                }
+            }
+        }
+        let max = bondgraph::element::MAX_PARAM_INPUTS;
+        if inputs.len() > max {
+            return Err(self.err(
+                BuildErrorKind::Invalid,
+                key,
+                format!("`{key}` reads {} signals; at most {max}", inputs.len()),
+            ));
+        }
+        let mut entries: Vec<kind::MatrixEntry> = Vec::with_capacity(exprs.len());
+        for e in &exprs {
+            self.note_constants(e);
+            let c = e
+                .compile(&|n| self.constants.get(n).copied(), &inputs)
+                .map_err(|m| self.err(BuildErrorKind::Invalid, key, m))?;
+            entries.push(Box::new(move |u| c.eval(u)));
+        }
+        Ok(MatrixParam {
+            rows: n1,
+            cols: n2,
+            inputs,
+            entries,
+        })
+    }
+    fn table(&self, key: &str) -> Result<Option<Box<dyn Params + '_>>, BuildError> {
+        let d = self.decl(key)?;
+        let Some(fields) = d.fields() else {
+            return Err(self.type_error(d));
+        };
+        let Some(raw) = self.params.get(key) else {
+            return Ok(None);
+        };
+        match &raw.value {
+            toml::Value::Table(t) => self.nested(self.full(key), fields, t, &raw.span).map(Some),
+            other => Err(self.err(
+                BuildErrorKind::Invalid,
+                key,
+                format!("`{key}` must be a table {{ … }}, not {}", other.type_str()),
+            )),
+        }
+    }
+    fn tables(&self, key: &str) -> Result<Vec<Box<dyn Params + '_>>, BuildError> {
+        let d = self.decl(key)?;
+        let Some(fields) = d.fields() else {
+            return Err(self.type_error(d));
+        };
+        let Some(raw) = self.params.get(key) else {
+            return if d.required() {
+                Err(self.missing(d))
+            } else {
+                Ok(Vec::new())
+            };
+        };
+        let toml::Value::Array(items) = &raw.value else {
+            return Err(self.err(
+                BuildErrorKind::Invalid,
+                key,
+                format!(
+                    "`{key}` must be an array of tables [{{ … }}, …], not {}",
+                    raw.value.type_str()
+                ),
+            ));
+        };
+        items
+            .iter()
+            .enumerate()
+            .map(|(i, v)| match v {
+                toml::Value::Table(t) => self.nested(
+                    format!("{}[{}]", self.full(key), i + 1),
+                    fields,
+                    t,
+                    &raw.span,
+                ),
+                other => Err(self.err(
+                    BuildErrorKind::Invalid,
+                    key,
+                    format!(
+                        "`{key}[{}]` must be a table {{ … }}, not {}",
+                        i + 1,
+                        other.type_str()
+                    ),
+                )),
+            })
+            .collect()
+    }
+}
