@@ -120,3 +120,58 @@ proptest! {
         }
     }
 }
+
+/// `models/lift_circuit.toml` with one replacement.
+fn lift_circuit_with(from: &str, to: &str) -> Result<bg_model::Model, bg_model::ModelError> {
+    let text = std::fs::read_to_string(bg_tests::root().join("models/lift_circuit.toml")).unwrap();
+    assert!(text.contains(from), "{from}");
+    bg_model::Model::from_text(
+        "lift_circuit.toml",
+        &text.replacen(from, to, 1),
+        &bg_sim::registry(),
+        &[],
+    )
+}
+
+/// Bad valve parameters are refused naming the element and the key, never a panic.
+#[test]
+fn bad_valve_parameters_name_the_element_and_key() {
+    let cases = [
+        // missing, misspelt, out of range, unknown word, excluding each other, wrong unit
+        (r#", p_crack = "p_relief""#, "", "relief", "p_crack"),
+        (r#"p_set = "p_cbv""#, r#"p_sett = "p_cbv""#, "cbv", "p_set"),
+        (r#"centre = "open""#, r#"centre = "opne""#, "dcv", "centre"),
+        (
+            r#"centre_stroke = 0.6"#,
+            "centre_stroke = 1.5",
+            "dcv",
+            "centre_stroke",
+        ),
+        (
+            r#"centre_stroke = 0.6"#,
+            "centre_stroke = 0.6, overlap = 0.1, underlap = 0.1",
+            "dcv",
+            "underlap",
+        ),
+        (r#"ratio = "ratio""#, "ratio = -1.0", "cbv", "ratio"),
+        (
+            r#"alpha = 1e-6 }"#,
+            "alpha = 1e-6, smoothing = 0.7 }",
+            "check",
+            "smoothing",
+        ),
+        (
+            r#"p_crack = "p_relief""#,
+            r#"p_crack = "16 m""#,
+            "relief",
+            "p_crack",
+        ),
+    ];
+    for (from, to, element, key) in cases {
+        let e = lift_circuit_with(from, to).unwrap_err();
+        assert_eq!(e.element.as_deref(), Some(element), "{from} → {to}: {e}");
+        assert!(e.to_string().contains(key), "{from} → {to}: {e}");
+    }
+    // and a value with a unit is read in SI: 160 bar is the file's 16 MPa
+    assert!(lift_circuit_with(r#"p_crack = "p_relief""#, r#"p_crack = "160 bar""#).is_ok());
+}

@@ -354,8 +354,8 @@ pub const KIND: KindDecl = KindDecl::element(
         orifice::W,
         orifice::RHO,
         ParamDecl::modulated("x_v", "1", "spool stroke, clamped to [−1, 1], e.g. \"spool.out\""),
-        ParamDecl::choice("centre", &["closed", "open", "tandem", "float"], "closed", "what the middle position connects"),
-        ParamDecl::number("centre_area", "1", "the centre passages' area, fraction of α").non_negative().default(1.0),
+        ParamDecl::choice("centre", &["closed", "open", "tandem", "float"], "closed", "connections of the middle position"),
+        ParamDecl::number("centre_area", "1", "area of the centre passages, as a fraction of α").non_negative().default(1.0),
         ParamDecl::number("centre_stroke", "1", "stroke at which the centre passages are shut")
             .range(Range { lo_open: true, ..Range::FRACTION })
             .default(0.2),

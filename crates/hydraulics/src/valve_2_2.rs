@@ -140,7 +140,7 @@ pub const KIND: KindDecl = KindDecl::element(
         orifice::W,
         orifice::RHO,
         ParamDecl::modulated("u", "1", "command, clamped to [0, 1]"),
-        ParamDecl::flag("normally_open", false, "u = 0 is the open position"),
+        ParamDecl::flag("normally_open", false, "whether u = 0 is the open position"),
         ParamDecl::number("g_leak", "m³/(s·Pa)", "leak conductance")
             .non_negative()
             .default(0.0),

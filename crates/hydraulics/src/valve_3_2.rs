@@ -165,7 +165,7 @@ pub const KIND: KindDecl = KindDecl::element(
             "1",
             "command, clamped to [0, 1]: 0 connects A to T, 1 P to A",
         ),
-        ParamDecl::flag("normally_open", false, "u = 0 connects P to A"),
+        ParamDecl::flag("normally_open", false, "whether u = 0 connects P to A"),
         ParamDecl::number("g_leak", "m³/(s·Pa)", "leak conductance of each edge")
             .non_negative()
             .default(0.0),
