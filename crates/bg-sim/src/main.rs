@@ -9,7 +9,7 @@ use std::sync::atomic::AtomicBool;
 use std::sync::{Arc, Mutex};
 
 use bg_model::{inspect, Model};
-use bg_sim::plot::{plot_all, work_precision, Drawn, Results, WorkPrecisionLine};
+use bg_sim::plot::{work_precision, Results, WorkPrecisionLine};
 use bg_sim::registry;
 use bondgraph::{Method, RowSink, SimulationError};
 use clap::{Parser, Subcommand};
@@ -85,9 +85,12 @@ enum Command {
         /// Print only errors.
         #[arg(short, long)]
         quiet: bool,
-        /// Also draw the paper's figures (`bg-sim plot`) from the results into this folder.
+        /// Also draw the model's `[[plot]]` figures from the results into this folder.
         #[arg(long, value_name = "DIR")]
         plots: Option<PathBuf>,
+        /// Format of those figures: png, svg or both.
+        #[arg(long, value_name = "FORMAT", default_value = "png")]
+        plot_format: String,
     },
     /// Run a model many times over a grid or a Latin-hypercube sample of values, in
     /// parallel, and write one summary row per run (docs/sweeps.md). Started again on the
@@ -136,6 +139,24 @@ enum Command {
     Check {
         /// The model file.
         model: PathBuf,
+        /// Override a value of the model file (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+    },
+    /// Draw a model's bond graph as SVG (or Graphviz DOT): element symbols, half-arrows,
+    /// causal strokes, signals; composites as one box each unless --expand (docs/graph.md).
+    Graph {
+        /// The model file.
+        model: PathBuf,
+        /// Output file (default: out/<model name>.svg, or .dot).
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Draw the members of every composite inside a frame instead of one box.
+        #[arg(long)]
+        expand: bool,
+        /// svg or dot (default: from the extension of --output, else svg).
+        #[arg(long, value_enum)]
+        format: Option<bg_sim::graph::Format>,
         /// Override a value of the model file (repeatable).
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
@@ -264,14 +285,28 @@ enum Command {
         #[arg(long = "floor", value_name = "PATTERN=VALUE")]
         floors: Vec<String>,
     },
-    /// Draw the knuckle boom figures of the paper (Figs. 7-11, 15-18) from a results CSV as
-    /// PNG; figures whose columns are missing are skipped.
+    /// Draw a model's `[[plot]]` figures from a results CSV (--model), or a quick look at
+    /// some of its columns, one panel each (--columns), as PNG and/or SVG.
     Plot {
         /// A CSV written by `bg-sim run`.
         results: PathBuf,
-        /// Folder for the PNGs (created if needed).
-        #[arg(long, default_value = "out/plots")]
+        /// The model file whose `[[plot]]` tables to draw.
+        #[arg(short, long, value_name = "MODEL.toml")]
+        model: Option<PathBuf>,
+        /// Draw these columns instead, comma-separated, one panel each.
+        #[arg(long, value_delimiter = ',', conflicts_with = "model")]
+        columns: Option<Vec<String>>,
+        /// Folder for the figures (created if needed).
+        #[arg(
+            short = 'o',
+            long = "out",
+            visible_alias = "output",
+            default_value = "out/plots"
+        )]
         out: PathBuf,
+        /// png, svg or both.
+        #[arg(long, default_value = "png")]
+        format: String,
     },
 }
 
@@ -318,6 +353,7 @@ fn dispatch(command: Command) -> ExitCode {
             set,
             quiet,
             plots,
+            plot_format,
         } => {
             let (code, written) = run(
                 &model,
@@ -331,7 +367,13 @@ fn dispatch(command: Command) -> ExitCode {
                 quiet,
             );
             match (plots, written) {
-                (Some(dir), Some(csv)) => match plot(&csv, &dir, quiet) {
+                (Some(dir), Some(csv)) => match plot(
+                    &csv,
+                    PlotWhat::Model(&model, &set),
+                    &dir,
+                    &plot_format,
+                    quiet,
+                ) {
                     ExitCode::SUCCESS => code,
                     failed => failed,
                 },
@@ -339,6 +381,13 @@ fn dispatch(command: Command) -> ExitCode {
             }
         }
         Command::Check { model, set } => check(&model, &set),
+        Command::Graph {
+            model,
+            output,
+            expand,
+            format,
+            set,
+        } => graph(&model, output.as_deref(), expand, format, &set),
         Command::Modes {
             model,
             at,
@@ -383,7 +432,20 @@ fn dispatch(command: Command) -> ExitCode {
                 ExitCode::from(2)
             }
         },
-        Command::Plot { results, out } => plot(&results, &out, false),
+        Command::Plot {
+            results,
+            model,
+            columns,
+            out,
+            format,
+        } => {
+            let what = match (&model, &columns) {
+                (Some(m), _) => PlotWhat::Model(m, &[]),
+                (None, Some(c)) => PlotWhat::Columns(c),
+                (None, None) => PlotWhat::Nothing,
+            };
+            plot(&results, what, &out, &format, false)
+        }
         Command::Compare {
             results,
             reference,
@@ -468,6 +530,28 @@ fn dispatch(command: Command) -> ExitCode {
             t_end,
             set: &set,
         }),
+    }
+}
+
+fn graph(
+    model: &Path,
+    out: Option<&Path>,
+    expand: bool,
+    format: Option<bg_sim::graph::Format>,
+    set: &[String],
+) -> ExitCode {
+    match bg_sim::graph::write(model, out, expand, format, set) {
+        Ok(w) => {
+            if let Some(p) = &w.problem {
+                tell!("note: drawn without causal strokes: {p}");
+            }
+            say!("{} nodes, {} bonds: {}", w.nodes, w.bonds, w.path.display());
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            tell!("error: {e}");
+            ExitCode::from(BAD_INPUT)
+        }
     }
 }
 
@@ -875,38 +959,82 @@ fn compare(
     }
 }
 
-fn plot(results: &Path, dir: &Path, quiet: bool) -> ExitCode {
-    let drawn = Results::read(results).and_then(|r| plot_all(&r, dir));
-    match drawn {
-        Ok(figures) => {
-            let mut written = 0;
-            for f in &figures {
-                match f {
-                    Drawn::Written(p) => {
-                        written += 1;
-                        if !quiet {
-                            say!("wrote {}", p.display());
-                        }
-                    }
-                    Drawn::Skipped { file, missing } => {
-                        if !quiet {
-                            say!("skipped {file}: no column {}", missing.join(", "));
-                        }
-                    }
+/// What `plot` draws.
+enum PlotWhat<'a> {
+    /// The `[[plot]]` tables of this model (with these `--set` overrides).
+    Model(&'a Path, &'a [String]),
+    /// A quick look at these columns.
+    Columns(&'a [String]),
+    /// Nothing was asked for.
+    Nothing,
+}
+
+fn plot(results: &Path, what: PlotWhat<'_>, dir: &Path, format: &str, quiet: bool) -> ExitCode {
+    use bg_sim::plot::{draw, draw_all, quick_look, Format};
+    let Some(format) = Format::parse(format) else {
+        tell!("error: --format {format}: expected png, svg or both");
+        return ExitCode::from(BAD_INPUT);
+    };
+    let table = match Results::read(results) {
+        Ok(t) => t,
+        Err(e) => {
+            tell!("error: {e}");
+            return ExitCode::from(BAD_INPUT);
+        }
+    };
+    let drawn = match what {
+        PlotWhat::Model(path, set) => {
+            let model = match Model::load(path, &registry(), set) {
+                Ok(m) => m,
+                Err(e) => {
+                    tell!("error: {e}");
+                    return ExitCode::from(BAD_INPUT);
                 }
-            }
-            if written == 0 {
+            };
+            if model.plots().is_empty() {
                 tell!(
-                    "error: {} has none of the columns of the figures (t, q1, l1, p_p1, F_c1, rho1, …)",
+                    "error: {} has no [[plot]] tables\n  hint: add one (docs/model-format.md, section Plots), or look at columns with `bg-sim plot {} --columns a,b`",
+                    path.display(),
                     results.display()
                 );
-                return ExitCode::from(1);
+                return ExitCode::from(FAILED);
+            }
+            draw_all(&table, model.plots(), model.file(), dir, format)
+        }
+        PlotWhat::Columns(columns) => {
+            let stem = results.file_stem().map_or_else(
+                || "columns".to_owned(),
+                |s| s.to_string_lossy().into_owned(),
+            );
+            quick_look(&table, results, &stem, columns).and_then(|p| {
+                std::fs::create_dir_all(dir).map_err(|source| bg_sim::plot::PlotError::Dir {
+                    path: dir.to_path_buf(),
+                    source,
+                })?;
+                draw(&table, &p, dir, format)
+            })
+        }
+        PlotWhat::Nothing => {
+            tell!(
+                "error: say what to draw: --model MODEL.toml (its [[plot]] tables) or --columns a,b (a quick look)\n  hint: {} has the columns {}",
+                results.display(),
+                table.names().join(", ")
+            );
+            return ExitCode::from(BAD_INPUT);
+        }
+    };
+    match drawn {
+        Ok(files) => {
+            if !quiet {
+                for f in &files {
+                    say!("wrote {}", f.display());
+                }
             }
             ExitCode::SUCCESS
         }
         Err(e) => {
             tell!("error: {e}");
-            ExitCode::from(2)
+            ExitCode::from(BAD_INPUT)
         }
     }
 }
@@ -990,7 +1118,16 @@ fn run(
         }
     }
     model.settings.interrupt = Some(interrupt_on_signals());
-    let (outcome, checks) = match model.run_into(&mut sink) {
+    let mut progress = bg_sim::progress::Progress::new(
+        &mut sink,
+        model.settings.t_start,
+        model.settings.t_end,
+        !quiet && std::io::IsTerminal::is_terminal(&std::io::stderr()),
+        !model.checks.is_empty(),
+    );
+    let ran = model.run_into(&mut progress);
+    drop(progress);
+    let (outcome, checks) = match ran {
         Ok(r) => r,
         Err(e) => {
             let _ = std::fs::remove_file(&partial);

@@ -1,25 +1,19 @@
-//! `bg-sim plot`: the figures of Cibicik, Pedersen & Egeland (2019), section 6, drawn as PNG
-//! from a results CSV of `models/knuckle_boom.toml` (or any CSV with the same columns).
+//! `bg-sim plot`: the figures a model declares in its `[[plot]]` tables
+//! ([`bg_model::plots`]), drawn from a results CSV as PNG and SVG ([`draw_all`]); a quick
+//! look at any columns of a CSV ([`quick_look`]); and the diagrams of `bench` and
+//! `sweep-plot` ([`work_precision`], [`contour`]).
 //!
-//! | file | the paper's | columns |
-//! |---|---|---|
-//! | `fig07_coordinates.png` | Fig. 7 | q1, q2, q3; qb1_1..3; qb2_1..3 |
-//! | `fig08_lengths.png` | Fig. 8 | l1, l2; ldot1, ldot2 |
-//! | `fig09_pressures.png` | Fig. 9 | p_p1, p_r1, p_p2, p_r2 |
-//! | `fig10_flows.png` | Fig. 10 | Q_p1, Q_r1, Q_p2, Q_r2 |
-//! | `fig11_valves.png` | Fig. 11 | x_v1, x_v2 (and the commands x_c1, x_c2) |
-//! | `fig15_link1_end.png` | Fig. 15 | x_e1, y_e1 (and w1_mid) |
-//! | `fig16_link2_end.png` | Fig. 16 | x_e2, y_e2 (and w2_mid) |
-//! | `fig17_cylinder_forces.png` | Fig. 17 | F_c1, F_c2 |
-//! | `fig18_reactions.png` | Fig. 18 | rho1..rho6 (and the paper's variant rho{k}_paper) |
-//!
-//! A figure whose required columns are missing is skipped (and reported); optional series
-//! (drawn dashed) are drawn when their columns are there. Text is set in DejaVu Sans, which
-//! the `dejavu` crate ships: no system fonts are needed.
+//! A panel's dashed series are drawn on top of its solid ones, each in a darker shade of the
+//! solid curve it goes with (the k-th dashed with the k-th solid), and the solid curves of
+//! such a panel wider and paler: a reference lying on its curve shows as dark dashes on a
+//! pale band. Text is set in DejaVu Sans, which the `dejavu` crate ships: no system fonts
+//! are needed.
 
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
+use bg_model::plots::{Panel, Plot, Series};
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::register_font;
 
@@ -64,6 +58,19 @@ pub enum PlotError {
     /// The bundled font was refused.
     #[error("cannot load the bundled font DejaVu Sans")]
     Font,
+    /// `--columns` names a column the results do not have.
+    #[error("{path}: {message}\n  hint: {hint}")]
+    Column {
+        /// The CSV.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+        /// What to do about it.
+        hint: String,
+    },
+    /// A plot of the model names a column the results do not have.
+    #[error("{0}")]
+    Model(Box<bg_model::ModelError>),
 }
 
 /// A results table: named columns of equal length, the first one `t`, at least one row
@@ -158,301 +165,50 @@ impl Results {
     }
 }
 
-/// One curve: a column, its legend, whether the figure needs it and how it is drawn.
-#[derive(Clone, Copy, Debug)]
-pub struct Series {
-    /// Column name.
-    pub column: &'static str,
-    /// Legend text.
-    pub label: &'static str,
-    /// Optional series are drawn only when their column exists; the figure is drawn without
-    /// them.
-    pub optional: bool,
-    /// Drawn as a thin dashed line (a variant or a command beside the main curves).
-    pub dashed: bool,
+/// Which files a plot is written as.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Format {
+    /// PNG (a bitmap, for the docs and a quick look).
+    #[default]
+    Png,
+    /// SVG (vector, for papers).
+    Svg,
+    /// Both.
+    Both,
 }
 
-/// A required curve.
-const fn s(column: &'static str, label: &'static str) -> Series {
-    Series {
-        column,
-        label,
-        optional: false,
-        dashed: false,
+impl Format {
+    /// `png`, `svg` or `both`.
+    #[must_use]
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "png" => Some(Self::Png),
+            "svg" => Some(Self::Svg),
+            "both" => Some(Self::Both),
+            _ => None,
+        }
     }
-}
 
-/// An optional curve, solid.
-const fn opt(column: &'static str, label: &'static str) -> Series {
-    Series {
-        column,
-        label,
-        optional: true,
-        dashed: false,
+    fn extensions(self) -> &'static [&'static str] {
+        match self {
+            Self::Png => &["png"],
+            Self::Svg => &["svg"],
+            Self::Both => &["png", "svg"],
+        }
     }
-}
-
-/// An optional curve, dashed.
-const fn variant(column: &'static str, label: &'static str) -> Series {
-    Series {
-        column,
-        label,
-        optional: true,
-        dashed: true,
-    }
-}
-
-/// One panel of a figure: curves over time on a common axis.
-#[derive(Clone, Copy, Debug)]
-pub struct Panel {
-    /// The y-axis label, with its unit.
-    pub y_label: &'static str,
-    /// The column values are divided by this (Pa → MPa: 1e6).
-    pub unit: f64,
-    /// The curves.
-    pub series: &'static [Series],
-    /// A close-up: only this time window (s), or the whole run.
-    pub window: Option<(f64, f64)>,
-}
-
-/// One PNG.
-#[derive(Clone, Copy, Debug)]
-pub struct Figure {
-    /// File name.
-    pub file: &'static str,
-    /// Title.
-    pub title: &'static str,
-    /// Panels, top to bottom.
-    pub panels: &'static [Panel],
-}
-
-/// The paper's figures (section 6).
-pub const FIGURES: &[Figure] = &[
-    Figure {
-        file: "fig07_coordinates.png",
-        title: "Fig. 7: generalized coordinates",
-        panels: &[
-            Panel {
-                y_label: "joint angles [rad]",
-                unit: 1.0,
-                series: &[s("q1", "q1"), s("q2", "q2"), s("q3", "q3")],
-                window: None,
-            },
-            Panel {
-                y_label: "Link 1 modes [m]",
-                unit: 1.0,
-                series: &[
-                    s("qb1_1", "qb1_1"),
-                    s("qb1_2", "qb1_2"),
-                    s("qb1_3", "qb1_3"),
-                ],
-                window: None,
-            },
-            Panel {
-                y_label: "Link 2 modes [m]",
-                unit: 1.0,
-                series: &[
-                    s("qb2_1", "qb2_1"),
-                    s("qb2_2", "qb2_2"),
-                    s("qb2_3", "qb2_3"),
-                ],
-                window: None,
-            },
-        ],
-    },
-    Figure {
-        file: "fig08_lengths.png",
-        title: "Fig. 8: cylinder lengths and their rates",
-        panels: &[
-            Panel {
-                y_label: "length [m]",
-                unit: 1.0,
-                series: &[s("l1", "l1"), s("l2", "l2")],
-                window: None,
-            },
-            Panel {
-                y_label: "rate [m/s]",
-                unit: 1.0,
-                series: &[s("ldot1", "dl1/dt"), s("ldot2", "dl2/dt")],
-                window: None,
-            },
-        ],
-    },
-    Figure {
-        file: "fig09_pressures.png",
-        title: "Fig. 9: chamber pressures",
-        panels: &[Panel {
-            y_label: "pressure [MPa]",
-            unit: 1e6,
-            series: &[
-                s("p_p1", "P_p1"),
-                s("p_r1", "P_r1"),
-                s("p_p2", "P_p2"),
-                s("p_r2", "P_r2"),
-            ],
-            window: None,
-        }],
-    },
-    Figure {
-        file: "fig10_flows.png",
-        title: "Fig. 10: valve flows into the chambers",
-        panels: &[Panel {
-            y_label: "flow [l/s]",
-            unit: 1e-3,
-            series: &[
-                s("Q_p1", "Q_p1"),
-                s("Q_r1", "Q_r1"),
-                s("Q_p2", "Q_p2"),
-                s("Q_r2", "Q_r2"),
-            ],
-            window: None,
-        }],
-    },
-    Figure {
-        file: "fig11_valves.png",
-        title: "Fig. 11: valve strokes",
-        panels: &[Panel {
-            y_label: "stroke [-]",
-            unit: 1.0,
-            series: &[
-                s("x_v1", "x_v1"),
-                s("x_v2", "x_v2"),
-                variant("x_c1", "command 1"),
-                variant("x_c2", "command 2"),
-            ],
-            window: None,
-        }],
-    },
-    Figure {
-        file: "fig15_link1_end.png",
-        title: "Fig. 15: end point of Link 1 (frame 0)",
-        panels: &[
-            Panel {
-                y_label: "x [m]",
-                unit: 1.0,
-                series: &[s("x_e1", "x_e1")],
-                window: None,
-            },
-            Panel {
-                y_label: "y [m]",
-                unit: 1.0,
-                series: &[s("y_e1", "y_e1")],
-                window: None,
-            },
-            Panel {
-                y_label: "mid-span deflection [mm]",
-                unit: 1e-3,
-                series: &[opt("w1_mid", "w1(L1/2)")],
-                window: None,
-            },
-            Panel {
-                y_label: "close-up [mm]",
-                unit: 1e-3,
-                series: &[opt("w1_mid", "w1(L1/2), 0-2 s")],
-                window: Some((0.0, 2.0)),
-            },
-        ],
-    },
-    Figure {
-        file: "fig16_link2_end.png",
-        title: "Fig. 16: end point of Link 2 (frame 0)",
-        panels: &[
-            Panel {
-                y_label: "x [m]",
-                unit: 1.0,
-                series: &[s("x_e2", "x_e2")],
-                window: None,
-            },
-            Panel {
-                y_label: "y [m]",
-                unit: 1.0,
-                series: &[s("y_e2", "y_e2")],
-                window: None,
-            },
-            Panel {
-                y_label: "mid-span deflection [mm]",
-                unit: 1e-3,
-                series: &[opt("w2_mid", "w2(L2/2)")],
-                window: None,
-            },
-            Panel {
-                y_label: "close-up [mm]",
-                unit: 1e-3,
-                series: &[opt("w2_mid", "w2(L2/2), 0-2 s")],
-                window: Some((0.0, 2.0)),
-            },
-        ],
-    },
-    Figure {
-        file: "fig17_cylinder_forces.png",
-        title: "Fig. 17: cylinder forces",
-        panels: &[Panel {
-            y_label: "force [kN]",
-            unit: 1e3,
-            series: &[s("F_c1", "F_c1"), s("F_c2", "F_c2")],
-            window: None,
-        }],
-    },
-    Figure {
-        file: "fig18_reactions.png",
-        title: "Fig. 18: reaction forces (dashed: lumped masses rigid with their pins, eqs. 91-94)",
-        panels: &[
-            Panel {
-                y_label: "Joint 1 [kN]",
-                unit: 1e3,
-                series: &[
-                    s("rho1", "rho1"),
-                    s("rho2", "rho2"),
-                    variant("rho1_paper", "rho1 paper"),
-                    variant("rho2_paper", "rho2 paper"),
-                ],
-                window: None,
-            },
-            Panel {
-                y_label: "Joint 2 [kN]",
-                unit: 1e3,
-                series: &[
-                    s("rho3", "rho3"),
-                    s("rho4", "rho4"),
-                    variant("rho3_paper", "rho3 paper"),
-                    variant("rho4_paper", "rho4 paper"),
-                ],
-                window: None,
-            },
-            Panel {
-                y_label: "pendulum pivot [kN]",
-                unit: 1e3,
-                series: &[
-                    s("rho5", "rho5"),
-                    s("rho6", "rho6"),
-                    variant("rho5_paper", "rho5 paper"),
-                    variant("rho6_paper", "rho6 paper"),
-                ],
-                window: None,
-            },
-        ],
-    },
-];
-
-/// What became of one figure.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum Drawn {
-    /// Written to this file.
-    Written(PathBuf),
-    /// Skipped: these required columns are missing.
-    Skipped {
-        /// The figure's file name.
-        file: &'static str,
-        /// The missing columns.
-        missing: Vec<&'static str>,
-    },
 }
 
 const FONT: &str = "sans-serif";
 const WIDTH: u32 = 1040;
-const PANEL_HEIGHT: u32 = 250;
 const TITLE_HEIGHT: u32 = 36;
 const LEGEND_WIDTH: u32 = 130;
+/// A model plot: width, legend width, height of a panel.
+const FIG_WIDTH: u32 = 1100;
+const FIG_LEGEND_WIDTH: u32 = 230;
+const PANEL_HEIGHT: u32 = 250;
+/// Left edge (px) of a model plot's legend: every legend entry's text starts right of it,
+/// every other text left of it.
+pub const LEGEND_LEFT: u32 = FIG_WIDTH - FIG_LEGEND_WIDTH;
 
 fn font() -> Result<(), PlotError> {
     static REGISTERED: OnceLock<bool> = OnceLock::new();
@@ -467,55 +223,133 @@ fn font() -> Result<(), PlotError> {
     }
 }
 
-/// Draw every figure of [`FIGURES`] whose columns `results` has into `dir` (created if
-/// needed).
-pub fn plot_all(results: &Results, dir: &Path) -> Result<Vec<Drawn>, PlotError> {
+/// A quick look at some columns of a results CSV (`bg-sim plot --columns`): one panel per
+/// column over `t`, each labelled with the column's name, in a plot whose file is `stem`. A
+/// column the results do not have is an error naming it and the similar ones.
+pub fn quick_look(
+    results: &Results,
+    csv: &Path,
+    stem: &str,
+    columns: &[String],
+) -> Result<Plot, PlotError> {
+    if columns.is_empty() {
+        return Err(PlotError::Column {
+            path: csv.to_path_buf(),
+            message: "--columns names no column".to_owned(),
+            hint: bg_model::plots::column_hint("", results.names()),
+        });
+    }
+    if let Some(c) = columns.iter().find(|c| results.column(c).is_none()) {
+        return Err(PlotError::Column {
+            path: csv.to_path_buf(),
+            message: format!("no column `{}`", bg_model::error::clip(c)),
+            hint: bg_model::plots::column_hint(c, results.names()),
+        });
+    }
+    Ok(Plot {
+        file: stem.to_owned(),
+        title: format!(
+            "{} of {}",
+            columns.join(", "),
+            csv.file_name().map_or_else(
+                || csv.display().to_string(),
+                |n| n.to_string_lossy().into_owned()
+            )
+        ),
+        x: "t".to_owned(),
+        x_label: "time [s]".to_owned(),
+        panels: columns
+            .iter()
+            .map(|c| Panel {
+                y_label: c.clone(),
+                unit: None,
+                x_range: None,
+                series: vec![Series {
+                    column: c.clone(),
+                    label: c.clone(),
+                    scale: 1.0,
+                    offset: 0.0,
+                    dashed: false,
+                    line: 0,
+                }],
+                line: 0,
+            })
+            .collect(),
+        line: 0,
+    })
+}
+
+/// Draw every plot of `plots` (a model's `[[plot]]` tables; `model` names the file in
+/// errors) from `results` into `dir` (created if needed), as `format`. The columns of every
+/// plot are checked first, so that a misnamed column draws nothing. Returns the files
+/// written.
+pub fn draw_all(
+    results: &Results,
+    plots: &[Plot],
+    model: &str,
+    dir: &Path,
+    format: Format,
+) -> Result<Vec<PathBuf>, PlotError> {
+    for p in plots {
+        p.check_columns(model, results.names())
+            .map_err(|e| PlotError::Model(Box::new(e)))?;
+    }
     std::fs::create_dir_all(dir).map_err(|source| PlotError::Dir {
         path: dir.to_path_buf(),
         source,
     })?;
-    FIGURES.iter().map(|f| plot(results, f, dir)).collect()
+    let mut written = Vec::new();
+    for p in plots {
+        written.extend(draw(results, p, dir, format)?);
+    }
+    Ok(written)
 }
 
-/// Draw one figure into `dir`.
-pub fn plot(results: &Results, figure: &Figure, dir: &Path) -> Result<Drawn, PlotError> {
-    let missing: Vec<&'static str> = figure
-        .panels
-        .iter()
-        .flat_map(|p| p.series.iter())
-        .filter(|s| !s.optional && results.column(s.column).is_none())
-        .map(|s| s.column)
-        .collect();
-    let panels: Vec<&Panel> = figure
-        .panels
-        .iter()
-        .filter(|p| p.series.iter().any(|s| results.column(s.column).is_some()))
-        .collect();
-    if !missing.is_empty() || panels.is_empty() {
-        return Ok(Drawn::Skipped {
-            file: figure.file,
-            missing,
-        });
-    }
+/// Draw one plot into `dir` as `format` (its columns checked by the caller: a missing one
+/// is left out). Returns the files written.
+pub fn draw(
+    results: &Results,
+    plot: &Plot,
+    dir: &Path,
+    format: Format,
+) -> Result<Vec<PathBuf>, PlotError> {
     font()?;
-    let path = dir.join(figure.file);
-    let fail = |e: &dyn std::fmt::Display| PlotError::Draw {
-        path: path.clone(),
-        message: e.to_string(),
-    };
-    let height = TITLE_HEIGHT + PANEL_HEIGHT * panels.len() as u32;
-    {
-        let root = BitMapBackend::new(&path, (WIDTH, height)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| fail(&e))?;
-        let (top, body) = root.split_vertically(TITLE_HEIGHT);
-        top.titled(figure.title, (FONT, 20).into_font().style(FontStyle::Bold))
-            .map_err(|e| fail(&e))?;
-        for (panel, area) in panels.iter().zip(body.split_evenly((panels.len(), 1))) {
-            draw_panel(results, panel, &area).map_err(|e| fail(&e))?;
+    let height = TITLE_HEIGHT + PANEL_HEIGHT * plot.panels.len().max(1) as u32;
+    let mut written = Vec::new();
+    for ext in format.extensions() {
+        let path = dir.join(format!("{}.{ext}", plot.file));
+        let fail = |message: String| PlotError::Draw {
+            path: path.clone(),
+            message,
+        };
+        if *ext == "svg" {
+            let root = SVGBackend::new(&path, (FIG_WIDTH, height)).into_drawing_area();
+            render(&root, results, plot).map_err(fail)?;
+        } else {
+            let root = BitMapBackend::new(&path, (FIG_WIDTH, height)).into_drawing_area();
+            render(&root, results, plot).map_err(fail)?;
         }
-        root.present().map_err(|e| fail(&e))?;
+        written.push(path);
     }
-    Ok(Drawn::Written(path))
+    Ok(written)
+}
+
+/// Draw `plot` on `root` (any backend) and present it.
+fn render<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    results: &Results,
+    plot: &Plot,
+) -> Result<(), String> {
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    root.fill(&WHITE).map_err(e)?;
+    let (top, body) = root.split_vertically(TITLE_HEIGHT);
+    top.titled(&plot.title, (FONT, 20).into_font().style(FontStyle::Bold))
+        .map_err(e)?;
+    let n = plot.panels.len().max(1);
+    for (panel, area) in plot.panels.iter().zip(body.split_evenly((n, 1))) {
+        draw_panel(results, plot, panel, &area).map_err(e)?;
+    }
+    root.present().map_err(e)
 }
 
 /// One line of a work–precision diagram: a method's runs as (wall time in ms, error) points,
@@ -643,22 +477,11 @@ const PALETTE: [RGBColor; 6] = [
     RGBColor(23, 190, 207),
 ];
 
-type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
-type DrawResult<T> =
-    Result<T, DrawingAreaErrorKind<<BitMapBackend<'static> as DrawingBackend>::ErrorType>>;
-
-const COLORS: [RGBColor; 4] = [
-    RGBColor(31, 119, 180),
-    RGBColor(214, 39, 40),
-    RGBColor(44, 160, 44),
-    RGBColor(148, 103, 189),
-];
-
 /// The y range of the curves, padded by 5 % (and widened around a constant).
-fn y_range(curves: &[(Series, Vec<(f64, f64)>)]) -> (f64, f64) {
+fn y_range(curves: &[Vec<(f64, f64)>]) -> (f64, f64) {
     let (lo, hi) = curves
         .iter()
-        .flat_map(|(_, pts)| pts.iter().map(|p| p.1))
+        .flat_map(|pts| pts.iter().map(|p| p.1))
         .filter(|v| v.is_finite())
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
             (a.min(v), b.max(v))
@@ -675,69 +498,137 @@ fn y_range(curves: &[(Series, Vec<(f64, f64)>)]) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
-fn draw_panel(results: &Results, panel: &Panel, area: &Area<'_>) -> DrawResult<()> {
-    let t = results.time();
-    let (mut t0, mut t1) = (t[0], t[t.len() - 1]);
-    if let Some((a, b)) = panel.window {
-        (t0, t1) = (t0.max(a), t1.min(b));
-    }
-    let t1 = t1.max(t0 + 1e-12);
-    let curves: Vec<(Series, Vec<(f64, f64)>)> = panel
+/// A tick label on an axis spanning `span`: a value that is zero but for rounding (2e-17
+/// on an axis of 2) is written 0.
+fn tick(v: f64, span: f64) -> String {
+    significant(if v.abs() <= 1e-9 * span.abs() { 0.0 } else { v })
+}
+
+/// The colour `c` mixed with white (`w` = 0: `c`, 1: white) or, for negative `w`, with
+/// black.
+fn shade(c: RGBColor, w: f64) -> RGBColor {
+    let to = if w >= 0.0 { 255.0 } else { 0.0 };
+    let w = w.abs();
+    let m = |v: u8| (f64::from(v) + w * (to - f64::from(v))).round() as u8;
+    RGBColor(m(c.0), m(c.1), m(c.2))
+}
+
+/// How each series of a panel is drawn: its colour and width. The k-th dashed series is the
+/// counterpart of the k-th solid one (a reference, a command, a variant): the same hue,
+/// darker, drawn on top; where a panel has dashed series its solid curves are wider and
+/// lighter, so that a dashed curve lying on its solid one shows as dark dashes on a pale
+/// band.
+fn styles(panel: &Panel) -> Vec<(RGBColor, u32)> {
+    let any_dashed = panel.series.iter().any(|s| s.dashed);
+    let any_solid = panel.series.iter().any(|s| !s.dashed);
+    let (mut solid, mut dashed) = (0, 0);
+    panel
         .series
         .iter()
-        .filter_map(|s| {
-            results.column(s.column).map(|c| {
-                let pts = t
-                    .iter()
+        .map(|s| {
+            if s.dashed {
+                dashed += 1;
+                let base = PALETTE[(dashed - 1) % PALETTE.len()];
+                if any_solid {
+                    (shade(base, -0.45), 2)
+                } else {
+                    (base, 2)
+                }
+            } else {
+                solid += 1;
+                let base = PALETTE[(solid - 1) % PALETTE.len()];
+                if any_dashed {
+                    (shade(base, 0.45), 5)
+                } else {
+                    (base, 2)
+                }
+            }
+        })
+        .collect()
+}
+
+fn draw_panel<DB: DrawingBackend>(
+    results: &Results,
+    plot: &Plot,
+    panel: &Panel,
+    area: &DrawingArea<DB, Shift>,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let empty: &[f64] = &[];
+    let x = results.column(&plot.x).unwrap_or(empty);
+    let (mut x0, mut x1) = x
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    if !x0.is_finite() {
+        (x0, x1) = (0.0, 1.0);
+    }
+    if let Some((a, b)) = panel.x_range {
+        (x0, x1) = (x0.max(a), x1.min(b));
+    }
+    let x1 = x1.max(x0 + 1e-12);
+    let curves: Vec<Vec<(f64, f64)>> = panel
+        .series
+        .iter()
+        .map(|s| {
+            results.column(&s.column).map_or_else(Vec::new, |c| {
+                x.iter()
                     .zip(c)
-                    .filter(|(&t, _)| (t0..=t1).contains(&t))
-                    .map(|(&t, &v)| (t, v / panel.unit))
-                    .collect();
-                (*s, pts)
+                    .map(|(&x, &v)| (x, s.show(v)))
+                    .filter(|&(x, v)| (x0..=x1).contains(&x) && v.is_finite())
+                    .collect()
             })
         })
         .collect();
     let (y0, y1) = y_range(&curves);
+    let width = area.dim_in_pixel().0;
     // the legend sits right of the chart, so it never hides a curve
-    let (plot_area, legend_area) = area.split_horizontally(WIDTH - LEGEND_WIDTH);
+    let (plot_area, legend_area) = area.split_horizontally(width.saturating_sub(FIG_LEGEND_WIDTH));
     let mut chart = ChartBuilder::on(&plot_area)
         .margin(8)
-        .x_label_area_size(34)
-        .y_label_area_size(78)
-        .build_cartesian_2d(t0..t1, y0..y1)?;
+        .x_label_area_size(36)
+        .y_label_area_size(84)
+        .build_cartesian_2d(x0..x1, y0..y1)?;
     chart
         .configure_mesh()
-        .x_desc("t [s]")
-        .y_desc(panel.y_label)
+        .x_desc(plot.x_label.as_str())
+        .y_desc(panel.axis_label())
         .label_style((FONT, 14))
         .axis_desc_style((FONT, 15))
+        .x_label_formatter(&|v| tick(*v, x1 - x0))
+        .y_label_formatter(&|v| tick(*v, y1 - y0))
         .light_line_style(RGBColor(238, 238, 238))
         .max_light_lines(2)
         .draw()?;
-    let mut solid = 0;
-    let mut dashed = 0;
-    for (i, (s, pts)) in curves.into_iter().enumerate() {
-        let (color, width) = if s.dashed {
-            dashed += 1;
-            (COLORS[(dashed - 1) % COLORS.len()].mix(0.9), 1)
-        } else {
-            solid += 1;
-            (COLORS[(solid - 1) % COLORS.len()].mix(1.0), 2)
-        };
-        let style = color.stroke_width(width);
+    let styles = styles(panel);
+    // solid curves first, the dashed ones on top
+    for dashed in [false, true] {
+        for ((s, pts), (color, w)) in panel.series.iter().zip(&curves).zip(&styles) {
+            if s.dashed != dashed {
+                continue;
+            }
+            let style = color.stroke_width(*w);
+            if dashed {
+                chart.draw_series(DashedLineSeries::new(pts.iter().copied(), 7, 5, style))?;
+            } else {
+                chart.draw_series(LineSeries::new(pts.iter().copied(), style))?;
+            }
+        }
+    }
+    for (i, (s, (color, w))) in panel.series.iter().zip(&styles).enumerate() {
         let y = 24 + 22 * i as i32;
+        let style = color.stroke_width(*w);
         if s.dashed {
-            chart.draw_series(DashedLineSeries::new(pts, 6, 4, style))?;
-            for x in [4, 16] {
+            for x in [4, 17] {
                 legend_area.draw(&PathElement::new(vec![(x, y), (x + 8, y)], style))?;
             }
         } else {
-            chart.draw_series(LineSeries::new(pts, style))?;
-            legend_area.draw(&PathElement::new(vec![(4, y), (28, y)], style))?;
+            legend_area.draw(&PathElement::new(vec![(4, y), (29, y)], style))?;
         }
         legend_area.draw(&Text::new(
-            s.label,
-            (34, y - 8),
+            s.label.clone(),
+            (36, y - 8),
             (FONT, 14).into_font().color(&BLACK),
         ))?;
     }
@@ -764,7 +655,7 @@ mod tests {
 
     #[test]
     fn y_range_pads_and_widens_constants() {
-        let c = |v: &[f64]| vec![(s("a", "a"), v.iter().map(|&y| (0.0, y)).collect())];
+        let c = |v: &[f64]| vec![v.iter().map(|&y| (0.0, y)).collect::<Vec<_>>()];
         let (lo, hi) = y_range(&c(&[0.0, 10.0]));
         assert!((lo + 0.5).abs() < 1e-12 && (hi - 10.5).abs() < 1e-12);
         let (lo, hi) = y_range(&c(&[2.0, 2.0]));

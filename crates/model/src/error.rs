@@ -32,6 +32,8 @@ pub enum ErrorKind {
     Settings,
     /// A `[scene]` switch is wrong.
     Scene,
+    /// A `[[plot]]` table is wrong, or names a column the results do not have.
+    Plot,
 }
 
 /// A problem in a model file.

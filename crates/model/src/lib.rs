@@ -26,7 +26,8 @@
 //! [`Model::load`] parses, applies `--set` overrides ([`overrides::apply`]), builds every
 //! element through the [`Registry`], assigns causality and assembles the equations. Every
 //! failure is a [`ModelError`] with file, line, column, element and hint.
-//! [`inspect`] goes as far as it can and reports what it found (`bg-sim check`).
+//! [`inspect`] goes as far as it can and reports what it found (`bg-sim check`);
+//! [`structure`] stops at the bond graph and its causality, for drawing (`bg-sim graph`).
 //!
 //! ## Scene switches
 //! `[scene]` declares the switches between richer and cheaper scenes (modes, lumped masses,
@@ -47,6 +48,7 @@ pub mod error;
 pub mod expr;
 pub mod load;
 pub mod overrides;
+pub mod plots;
 pub mod reader;
 pub mod registry;
 pub mod scene;
@@ -54,7 +56,8 @@ pub mod steady;
 
 pub use describe::{describe, parameter_table, KindReport};
 pub use error::{ErrorKind, ModelError};
-pub use load::{inspect, Check, CheckResult, Inspection, Model};
+pub use load::{inspect, structure, Check, CheckResult, Entry, Inspection, Model, Structure};
+pub use plots::{Panel, Plot, Series};
 pub use reader::{ElementSpec, RawValue};
 pub use registry::Registry;
 pub use scene::{Choice, Scene, Switch};

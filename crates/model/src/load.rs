@@ -21,6 +21,9 @@ use crate::reader::{ElementSpec, RawValue};
 use crate::registry::Registry;
 use crate::scene::Scene;
 
+mod structure;
+pub use structure::{structure, Entry, Structure};
+
 type SpannedMap<V> = IndexMap<Spanned<String>, Spanned<V>>;
 
 #[derive(Deserialize)]
@@ -45,6 +48,9 @@ struct FileSpec {
     check: Vec<Spanned<CheckSpec>>,
     #[serde(default)]
     scene: SpannedMap<toml::Value>,
+    /// `[[plot]]`: read by `crate::plots`.
+    #[serde(default, rename = "plot")]
+    _plot: serde::de::IgnoredAny,
 }
 
 #[derive(Deserialize, Default)]
@@ -274,6 +280,8 @@ struct Source {
     events: Vec<EventDef>,
     /// Lines (1-based) that `--set` wrote or changed: errors there say so.
     changed_lines: Vec<usize>,
+    /// The `[[plot]]` tables (`crate::plots`).
+    plots: Vec<crate::plots::Plot>,
 }
 
 impl Source {
@@ -618,7 +626,7 @@ fn syntax(file: &str, text: &str, e: &toml::de::Error) -> ModelError {
     }
     ModelError::new(ErrorKind::Syntax, file, message)
         .at(pos)
-        .hint("a model has the sections title, description, [parameters], [elements], [bonds], [simulation], [initial], [[events]], [outputs], [[check]], [scene]")
+        .hint("a model has the sections title, description, [parameters], [elements], [bonds], [simulation], [initial], [[events]], [outputs], [[check]], [scene], [[plot]]")
 }
 
 /// The lines (1-based) of `after` that differ from those of `before`.
@@ -732,7 +740,9 @@ fn parse(
         elements: Vec::new(),
         events: Vec::new(),
         changed_lines,
+        plots: Vec::new(),
     };
+    source.plots = crate::plots::read(&text, &|span, m| source.err(ErrorKind::Plot, span, m))?;
     for (k, v) in &spec.parameters {
         if !valid_name(k.get_ref()) || RESERVED.contains(&k.get_ref().as_str()) {
             return Err(source
@@ -1449,6 +1459,12 @@ impl Model {
         let cg = causal(&p, g)?;
         let eqs = StateEquations::new(cg).map_err(|e| core_error(&p.source, e))?;
         finish(p, eqs)
+    }
+
+    /// The figures the file declares (`[[plot]]`, [`crate::plots`]).
+    #[must_use]
+    pub fn plots(&self) -> &[crate::plots::Plot] {
+        &self.source.plots
     }
 
     /// The file the model came from.
