@@ -40,7 +40,10 @@ fn block(kind: &str) -> Option<(PathBuf, std::ops::Range<usize>)> {
         let text = std::fs::read_to_string(&path).unwrap();
         if let Some(i) = text.find(&b) {
             let start = i + text[i..].find("-->").unwrap() + 3;
-            let end = start + text[start..].find(END).unwrap_or_else(|| panic!("{kind}: no end marker in {}", path.display()));
+            let end = start
+                + text[start..]
+                    .find(END)
+                    .unwrap_or_else(|| panic!("{kind}: no end marker in {}", path.display()));
             return Some((path, start..end));
         }
     }
@@ -97,7 +100,11 @@ fn kinds_name_lists_every_declared_parameter_and_builds_the_example() {
         let mut all = Vec::new();
         names("", k.params, &mut all);
         for n in all {
-            assert!(text.contains(&format!("`{n}`")), "`bg-sim kinds {}` does not list `{n}`:\n{text}", k.name);
+            assert!(
+                text.contains(&format!("`{n}`")),
+                "`bg-sim kinds {}` does not list `{n}`:\n{text}",
+                k.name
+            );
         }
         assert!(text.contains("ports:"), "{}", k.name);
     }
@@ -105,7 +112,10 @@ fn kinds_name_lists_every_declared_parameter_and_builds_the_example() {
 
 /// A one-element model with `k`'s example and `extra` appended to its parameters.
 fn load_with(k: &KindDecl, example: &str) -> Result<Model, ModelError> {
-    let text = format!("title = \"kinds\"\n[elements]\nx = {{ kind = \"{}\", {} }}\n", k.name, example);
+    let text = format!(
+        "title = \"kinds\"\n[elements]\nx = {{ kind = \"{}\", {} }}\n",
+        k.name, example
+    );
     Model::from_text("kinds.toml", &text, &bg_sim::registry(), &[])
 }
 
@@ -113,7 +123,11 @@ fn assert_positioned(k: &KindDecl, e: &ModelError, what: &str) {
     assert_eq!(e.file, "kinds.toml", "{}: {what}: {e}", k.name);
     assert_eq!(e.line, Some(3), "{}: {what}: {e}", k.name);
     assert_eq!(e.element.as_deref(), Some("x"), "{}: {what}: {e}", k.name);
-    assert!(e.hint.as_deref().is_some_and(|h| !h.is_empty()), "{}: {what}: no hint: {e}", k.name);
+    assert!(
+        e.hint.as_deref().is_some_and(|h| !h.is_empty()),
+        "{}: {what}: no hint: {e}",
+        k.name
+    );
 }
 
 #[test]
@@ -122,33 +136,69 @@ fn unknown_misspelt_and_out_of_range_keys_are_refused_with_line_element_and_hint
     for k in kinds() {
         let sep = if k.example.is_empty() { "" } else { ", " };
         // unknown
-        let e = load_with(&k, &format!("{}{sep}zz_not_a_parameter = 1", k.example)).err().unwrap_or_else(|| panic!("{}: unknown key accepted", k.name));
+        let e = load_with(&k, &format!("{}{sep}zz_not_a_parameter = 1", k.example))
+            .err()
+            .unwrap_or_else(|| panic!("{}: unknown key accepted", k.name));
         assert_eq!(e.kind, ErrorKind::ExtraParameter, "{}: {e}", k.name);
         assert_positioned(&k, &e, "unknown key");
         // misspelt: a declared number given in the example, with one letter doubled
-        if let Some(d) = k.params.iter().find(|d| d.ty == ParamType::Number && k.example.contains(&format!("{} =", d.name)) && d.name.len() > 1) {
+        if let Some(d) = k.params.iter().find(|d| {
+            d.ty == ParamType::Number
+                && k.example.contains(&format!("{} =", d.name))
+                && d.name.len() > 1
+        }) {
             let typo = format!("{}{}", d.name, d.name.chars().last().unwrap());
-            let text = k.example.replacen(&format!("{} =", d.name), &format!("{typo} ="), 1);
-            let e = load_with(&k, &text).err().unwrap_or_else(|| panic!("{}: `{typo}` accepted", k.name));
+            let text = k
+                .example
+                .replacen(&format!("{} =", d.name), &format!("{typo} ="), 1);
+            let e = load_with(&k, &text)
+                .err()
+                .unwrap_or_else(|| panic!("{}: `{typo}` accepted", k.name));
             assert_positioned(&k, &e, "misspelt key");
-            assert!(e.hint.as_deref().unwrap_or("").contains(&format!("`{}`", d.name)), "{}: the hint should name `{}`: {e}", k.name, d.name);
+            assert!(
+                e.hint
+                    .as_deref()
+                    .unwrap_or("")
+                    .contains(&format!("`{}`", d.name)),
+                "{}: the hint should name `{}`: {e}",
+                k.name,
+                d.name
+            );
         }
         // out of range: a declared number with a bound
-        if let Some(d) = k.params.iter().find(|d| matches!(d.ty, ParamType::Number) && d.range != Range::ANY && d.range.lo.is_finite()) {
+        if let Some(d) = k.params.iter().find(|d| {
+            matches!(d.ty, ParamType::Number) && d.range != Range::ANY && d.range.lo.is_finite()
+        }) {
             ranged += 1;
-            let bad = if d.range.lo_open { d.range.lo } else { d.range.lo - 1.0 };
+            let bad = if d.range.lo_open {
+                d.range.lo
+            } else {
+                d.range.lo - 1.0
+            };
             let text = if k.example.contains(&format!("{} =", d.name)) {
                 let start = k.example.find(&format!("{} =", d.name)).unwrap();
                 let rest = &k.example[start..];
                 let end = rest.find(',').map_or(k.example.len(), |i| start + i);
-                format!("{}{} = {bad}{}", &k.example[..start], d.name, &k.example[end..])
+                format!(
+                    "{}{} = {bad}{}",
+                    &k.example[..start],
+                    d.name,
+                    &k.example[end..]
+                )
             } else {
                 format!("{}{sep}{} = {bad}", k.example, d.name)
             };
-            let e = load_with(&k, &text).err().unwrap_or_else(|| panic!("{}: {} = {bad} accepted", k.name, d.name));
+            let e = load_with(&k, &text)
+                .err()
+                .unwrap_or_else(|| panic!("{}: {} = {bad} accepted", k.name, d.name));
             assert_eq!(e.kind, ErrorKind::BadParameter, "{}: {e}", k.name);
             assert_positioned(&k, &e, "out of range");
-            assert!(e.message.contains(&d.range.to_string()), "{}: the message should name the range {}: {e}", k.name, d.range);
+            assert!(
+                e.message.contains(&d.range.to_string()),
+                "{}: the message should name the range {}: {e}",
+                k.name,
+                d.range
+            );
         }
     }
     assert!(ranged >= 10, "only {ranged} kinds have a bounded number");
@@ -167,10 +217,22 @@ t_end = 1.0
 "#;
     let m = Model::from_text("units.toml", text, &bg_sim::registry(), &[]).unwrap();
     let x0 = &m.x0;
-    assert!((x0[0] - 1e6).abs() <= 1e-9, "p0 = \"10 bar\" gave {}", x0[0]);
-    let k = bg_sim::registry().get("hydraulics.chamber").copied().unwrap();
-    let e = load_with(&k, "volume = 1e-3, beta = \"3 m\"").err().unwrap();
+    assert!(
+        (x0[0] - 1e6).abs() <= 1e-9,
+        "p0 = \"10 bar\" gave {}",
+        x0[0]
+    );
+    let k = bg_sim::registry()
+        .get("hydraulics.chamber")
+        .copied()
+        .unwrap();
+    let e = load_with(&k, "volume = 1e-3, beta = \"3 m\"")
+        .err()
+        .unwrap();
     assert_eq!(e.kind, ErrorKind::BadParameter, "{e}");
-    assert!(e.message.contains("pressure") && e.message.contains("length"), "{e}");
+    assert!(
+        e.message.contains("pressure") && e.message.contains("length"),
+        "{e}"
+    );
     assert_positioned(&k, &e, "wrong unit");
 }

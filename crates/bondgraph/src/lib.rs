@@ -70,10 +70,12 @@ pub mod equations;
 pub mod equilibrium;
 pub mod error;
 pub mod graph;
+pub mod io;
 pub mod kind;
 pub mod kinds;
 pub mod local_jacobian;
 pub mod modes;
+pub mod partials_check;
 pub mod radau;
 pub mod simulate;
 
@@ -89,10 +91,11 @@ pub use equilibrium::{solve_steady, Condition, Equilibrium, EquilibriumError, St
 pub use error::{CausalityError, Error, GraphError, ParamError, SimulationError};
 pub use graph::{BondGraph, Node};
 pub use kind::{BuildError, Composite, KindDecl, ParamDecl, Params};
-pub use local_jacobian::{check_partials, LocalJacobian, LocalShape};
+pub use local_jacobian::{LocalJacobian, LocalShape};
 pub use modes::{modes, modes_of, stiffness_ratio, Mode, ModesError};
 /// The dense matrix type of [`StateEquations::jacobian`].
 pub use nalgebra::DMatrix;
+pub use partials_check::check_partials;
 pub use radau::{OdeSystem, Radau5, RadauError, RadauOptions, RadauStats, StepReport};
 pub use simulate::{
     check_in_memory, simulate, simulate_into, Event, Method, Outcome, Output, RowSink, Settings,

@@ -5,8 +5,8 @@ use bondgraph::KindDecl;
 
 use crate::{
     chamber, check_valve, counterbalance_valve, cylinder, directional_valve, end_stop,
-    flow_control_valve, leakage, orifice, pilot_check_valve, piston, pressure_reducing_valve,
-    relief_valve, sequence_valve, valve, valve_2_2, valve_3_2,
+    flow_control_valve, laminar, leakage, orifice, pilot_check_valve, piston,
+    pressure_reducing_valve, relief_valve, sequence_valve, valve, valve_2_2, valve_3_2,
 };
 
 /// Every kind of this crate.
@@ -19,6 +19,7 @@ pub const KINDS: &[KindDecl] = &[
     orifice::KIND,
     valve::KIND,
     cylinder::KIND,
+    laminar::KIND,
     relief_valve::KIND,
     check_valve::KIND,
     pilot_check_valve::KIND,

@@ -29,6 +29,7 @@
 //! - [`Piston`] (`hydraulics.piston`): the TF pair A_p, A_r (eqs. 80–81) and the stroke.
 //! - [`EndStop`] (`hydraulics.end_stop`): stiff spring–damper past the stroke ends.
 //! - [`Leakage`] (`hydraulics.leakage`, `hydraulics.tank_leakage`): laminar R (eq. 82).
+//! - [`Laminar`] (`hydraulics.laminar`): a pipe's laminar resistance (Hagen–Poiseuille).
 //! - [`Orifice`] (`hydraulics.orifice`) and [`Valve`] (`hydraulics.valve`): eqs. 29–31 with
 //!   the square root regularised by [`reg_root`].
 //!
@@ -68,6 +69,7 @@ pub mod directional_valve;
 pub mod end_stop;
 pub mod flow_control_valve;
 pub mod kinds;
+pub mod laminar;
 pub mod leakage;
 pub mod orifice;
 pub mod pilot_check_valve;
@@ -91,6 +93,7 @@ pub use directional_valve::{Centre, DirectionalValve};
 pub use end_stop::EndStop;
 pub use flow_control_valve::FlowControlValve;
 pub use kinds::KINDS;
+pub use laminar::{pipe_resistance, Laminar};
 pub use leakage::Leakage;
 pub use orifice::{alpha, reg_root, reg_root_derivative, Orifice};
 pub use pilot_check_valve::PilotCheckValve;
