@@ -76,6 +76,13 @@ jl    = { kind = "0" }
 ori   = { kind = "hydraulics.orifice", alpha = 1e-6, opening = "0.5 + 0.4*pc.out", p_tr = 1e5 }
 tank  = { kind = "Se", e = 0.0 }
 leak  = { kind = "hydraulics.tank_leakage", r = 1e12 }
+sump  = { kind = "Se", e = 0.0 }
+pmp   = { kind = "hydraulics.pump", displacement = 1e-6, speed = "100 + 10*sin(t)", fraction = "0.5 + 0.3*pc.out", c_l = 1e-12, t_c = 1.0, b = 1e-3 }
+mot   = { kind = "hydraulics.motor", displacement = 2e-6, fraction = "0.8 + 0.1*sin(t)", c_l = 1e-12, t_c = 0.5, t_s = 0.8, omega_s = 1.0, b = 1e-3 }
+drn   = { kind = "Se", e = 0.0 }
+jm    = { kind = "1" }
+rot   = { kind = "I", m = 1e-3, p0 = 0.01 }
+fr    = { kind = "hydraulics.friction", f_c = 0.2, f_s = 0.3, v_s = 1.0, v_tanh = 0.1, b = 1e-3 }
 
 [bonds]
 b1 = "src -> j0"
@@ -94,6 +101,13 @@ b13 = "jl -> ch"
 b14 = "jl -> ori.a"
 b15 = "ori.b -> tank"
 b16 = "jl -> leak"
+b17 = "sump -> pmp.a"
+b18 = "pmp.b -> jl"
+b19 = "jl -> mot.a"
+b20 = "mot.b -> drn"
+b21 = "mot.shaft -> jm"
+b22 = "jm -> rot"
+b23 = "jm -> fr"
 
 [simulation]
 t_end = 0.1

@@ -121,3 +121,50 @@ tol = 0.0
     assert!(e.message.contains("side"), "{e}");
     assert_eq!(e.line, Some(3));
 }
+
+fn drive_with(from: &str, to: &str) -> Result<Model, bg_model::ModelError> {
+    let text = std::fs::read_to_string(model_path("motor_drive")).unwrap();
+    assert!(text.contains(from), "{from}");
+    Model::from_text("drive.toml", &text.replacen(from, to, 1), &registry(), &[])
+}
+
+#[test]
+fn machine_parameters_are_checked_with_the_key_named() {
+    let motor = r#"displacement = "d_m", c_l = "c_lm", t_c = "t_cm""#;
+    for (bad, key) in [
+        (
+            r#"displacement = 0.0, c_l = "c_lm", t_c = "t_cm""#,
+            "displacement",
+        ),
+        (r#"displacement = "d_m", c_l = -1.0, t_c = "t_cm""#, "c_l"),
+        (r#"displacement = "d_m", c_l = "c_lm", t_c = -2.0"#, "t_c"),
+        (
+            r#"displacement = "d_m", c_l = "c_lm", t_c = "t_cm", omega_tanh = 0.0"#,
+            "omega_tanh",
+        ),
+        (
+            r#"displacement = "d_m", c_l = "c_lm", t_c = "t_cm", fraction = 1.5"#,
+            "fraction",
+        ),
+    ] {
+        let e = drive_with(motor, bad).unwrap_err();
+        assert_eq!(e.kind, ErrorKind::BadParameter, "{e}");
+        assert_eq!(e.element.as_deref(), Some("motor"), "{e}");
+        assert!(e.message.contains(key), "{key}: {e}");
+    }
+    // a breakaway torque needs its Stribeck speed
+    let e = drive_with(motor, &format!("{motor}, t_s = 3.0")).unwrap_err();
+    assert_eq!(e.kind, ErrorKind::MissingParameter, "{e}");
+    assert!(e.message.contains("omega_s"), "{e}");
+    assert!(drive_with(motor, &format!("{motor}, t_s = 3.0, omega_s = 2.0")).is_ok());
+    // a motor has no set speed: the key is refused, not ignored
+    let e = drive_with(motor, &format!(r#"{motor}, speed = 100.0"#)).unwrap_err();
+    assert!(e.to_string().contains("speed"), "{e}");
+}
+
+#[test]
+fn a_pump_without_speed_has_a_shaft_to_bond() {
+    // Without `speed` the pump has a shaft port, and a shaft left open is reported.
+    let e = drive_with(r#"speed = "drive.out", "#, "").unwrap_err();
+    assert!(e.to_string().contains("shaft"), "{e}");
+}

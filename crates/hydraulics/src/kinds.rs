@@ -5,7 +5,7 @@ use bondgraph::KindDecl;
 
 use crate::{
     chamber, check_valve, counterbalance_valve, cylinder, directional_valve, end_stop,
-    flow_control_valve, laminar, leakage, orifice, pilot_check_valve, piston,
+    flow_control_valve, friction, laminar, leakage, machine, orifice, pilot_check_valve, piston,
     pressure_reducing_valve, relief_valve, sequence_valve, valve, valve_2_2, valve_3_2,
 };
 
@@ -30,4 +30,7 @@ pub const KINDS: &[KindDecl] = &[
     valve_2_2::KIND,
     valve_3_2::KIND,
     flow_control_valve::KIND,
+    machine::PUMP,
+    machine::MOTOR,
+    friction::KIND,
 ];

@@ -32,6 +32,10 @@
 //! - [`Laminar`] (`hydraulics.laminar`): a pipe's laminar resistance (Hagen–Poiseuille).
 //! - [`Orifice`] (`hydraulics.orifice`) and [`Valve`] (`hydraulics.valve`): eqs. 29–31 with
 //!   the square root regularised by [`reg_root`].
+//! - [`Machine`] (`hydraulics.pump`, `hydraulics.motor`): displacement machine, Q = D·ω,
+//!   T = D·Δp with leakage and friction losses; a pump may run at a set `speed`.
+//! - [`Friction`] (`hydraulics.friction`): regularised Coulomb + Stribeck + viscous
+//!   ([`FrictionLaw`], also the machines' friction torque).
 //!
 //! The spool's P-controller (eq. 83) and first-order lag are the core's `p_control` and
 //! `lag`; they read the cylinder length `<cylinder>_piston.l`.
@@ -68,9 +72,11 @@ pub mod cylinder;
 pub mod directional_valve;
 pub mod end_stop;
 pub mod flow_control_valve;
+pub mod friction;
 pub mod kinds;
 pub mod laminar;
 pub mod leakage;
+pub mod machine;
 pub mod orifice;
 pub mod pilot_check_valve;
 pub mod piston;
@@ -92,9 +98,11 @@ pub use cylinder::{
 pub use directional_valve::{Centre, DirectionalValve};
 pub use end_stop::EndStop;
 pub use flow_control_valve::FlowControlValve;
+pub use friction::{Friction, FrictionLaw};
 pub use kinds::KINDS;
 pub use laminar::{pipe_resistance, Laminar};
 pub use leakage::Leakage;
+pub use machine::{Machine, Role};
 pub use orifice::{alpha, reg_root, reg_root_derivative, Orifice};
 pub use pilot_check_valve::PilotCheckValve;
 pub use piston::Piston;
