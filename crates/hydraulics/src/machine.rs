@@ -389,7 +389,7 @@ pub const PUMP: KindDecl = KindDecl::element(
         ParamDecl::modulated(
             "speed",
             "rad/s",
-            "shaft speed ω: the pump is a flow source with no shaft port",
+            "shaft speed ω (\"1500 rpm\", or a signal): the pump is a flow source with no shaft port",
         )
         .optional("a shaft port, driven by the model"),
     ],
