@@ -4,8 +4,10 @@
 use bondgraph::KindDecl;
 
 use crate::{
-    accumulator, chamber, cylinder, end_stop, friction, laminar, leakage, line, machine, orifice,
-    piston, tank, valve,
+    accumulator, chamber, check_valve, counterbalance_valve, cylinder, directional_valve, end_stop,
+    flow_control_valve, friction, laminar, leakage, line, machine, orifice, pilot_check_valve,
+    piston, pressure_reducing_valve, relief_valve, sequence_valve, tank, valve, valve_2_2,
+    valve_3_2,
 };
 
 /// Every kind of this crate.
@@ -22,6 +24,16 @@ pub const KINDS: &[KindDecl] = &[
     accumulator::KIND,
     line::KIND,
     tank::KIND,
+    relief_valve::KIND,
+    check_valve::KIND,
+    pilot_check_valve::KIND,
+    counterbalance_valve::KIND,
+    sequence_valve::KIND,
+    pressure_reducing_valve::KIND,
+    directional_valve::KIND,
+    valve_2_2::KIND,
+    valve_3_2::KIND,
+    flow_control_valve::KIND,
     machine::PUMP,
     machine::MOTOR,
     friction::KIND,

@@ -46,6 +46,20 @@
 //! The spool's P-controller (eq. 83) and first-order lag are the core's `p_control` and
 //! `lag`; they read the cylinder length `<cylinder>_piston.l`.
 //!
+//! ## Valves (any supply: every port is hydraulic; `docs/hydraulics.md`, "Valves")
+//! Each opening passes oil as an orifice, `α·x·regRoot(Δp)`, with a laminar leak; every valve
+//! conserves volume and only dissipates.
+//! - Pressure-operated, on the shared law of [`PressureValve`] with the C¹ opening [`ramp`]:
+//!   [`ReliefValve`] (`hydraulics.relief_valve`, optional poppet lag), [`CheckValve`]
+//!   (`hydraulics.check_valve`), [`PilotCheckValve`] (`hydraulics.pilot_check_valve`),
+//!   [`CounterbalanceValve`] (`hydraulics.counterbalance_valve`), [`SequenceValve`]
+//!   (`hydraulics.sequence_valve`), [`PressureReducingValve`]
+//!   (`hydraulics.pressure_reducing_valve`).
+//! - Spool-operated: [`DirectionalValve`] (`hydraulics.directional_valve`: 4/3, ports P, T,
+//!   A, B, [`Centre`] closed/open/tandem/float, overlap/underlap), [`Valve22`]
+//!   (`hydraulics.valve_2_2`), [`Valve32`] (`hydraulics.valve_3_2`).
+//! - [`FlowControlValve`] (`hydraulics.flow_control_valve`): pressure-compensated.
+//!
 //! ## The cylinder as one component
 //! [`Cylinder`] (`hydraulics.cylinder`) assembles chambers, piston, leakage, valve and end
 //! stop; [`Cylinder::composite`] for model files, [`Cylinder::add_to`] for a [`BondGraph`].
@@ -59,8 +73,12 @@
 
 pub mod accumulator;
 pub mod chamber;
+pub mod check_valve;
+pub mod counterbalance_valve;
 pub mod cylinder;
+pub mod directional_valve;
 pub mod end_stop;
+pub mod flow_control_valve;
 pub mod fluid;
 pub mod friction;
 pub mod kinds;
@@ -69,16 +87,28 @@ pub mod leakage;
 pub mod line;
 pub mod machine;
 pub mod orifice;
+pub mod pilot_check_valve;
 pub mod piston;
+pub mod pressure_reducing_valve;
+pub mod pressure_valve;
+pub mod ramp;
+pub mod relief_valve;
+pub mod sequence_valve;
 pub mod tank;
 pub mod valve;
+pub mod valve_2_2;
+pub mod valve_3_2;
 
 pub use accumulator::Accumulator;
 pub use chamber::{Chamber, Side};
+pub use check_valve::CheckValve;
+pub use counterbalance_valve::CounterbalanceValve;
 pub use cylinder::{
     hold_pressures, Cylinder, CylinderPorts, EndStopSpec, InitialPressures, ValveSpec,
 };
+pub use directional_valve::{Centre, DirectionalValve};
 pub use end_stop::EndStop;
+pub use flow_control_valve::FlowControlValve;
 pub use fluid::{Fluid, FluidOptions};
 pub use friction::{Friction, FrictionLaw};
 pub use kinds::KINDS;
@@ -87,6 +117,14 @@ pub use leakage::Leakage;
 pub use line::{Line, LineSpec, Wall};
 pub use machine::{Machine, Role};
 pub use orifice::{alpha, reg_root, reg_root_derivative, Orifice};
+pub use pilot_check_valve::PilotCheckValve;
 pub use piston::Piston;
+pub use pressure_reducing_valve::PressureReducingValve;
+pub use pressure_valve::{Opening, PressureValve};
+pub use ramp::ramp;
+pub use relief_valve::ReliefValve;
+pub use sequence_valve::SequenceValve;
 pub use tank::Tank;
 pub use valve::Valve;
+pub use valve_2_2::Valve22;
+pub use valve_3_2::Valve32;
