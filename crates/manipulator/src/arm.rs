@@ -17,7 +17,6 @@ use nalgebra::Vector2;
 
 use crate::joint::RevoluteJoint;
 use crate::link::Link;
-use crate::pin::Pin;
 use crate::quadrature::GaussLegendre;
 use crate::screw::{rot_z_cs, CoordinateTransform};
 use crate::shape_integrals::ShapeIntegrals;
@@ -169,18 +168,6 @@ impl PlanarArm {
             x,
             psi: modes.iter().map(|m| m.value(x)).collect(),
             theta: modes.iter().map(|m| m.slope(x)).collect(),
-        }
-    }
-
-    /// Check a pin lies on the arm (or is a finite ground point).
-    pub fn check_pin(&self, pin: &Pin) -> Result<(), ParamError> {
-        match *pin {
-            Pin::Ground(p) => {
-                ParamError::finite("pin.x", p.x)?;
-                ParamError::finite("pin.y", p.y)?;
-                Ok(())
-            }
-            Pin::Link { link, x } => self.station(link, x).map(|_| ()),
         }
     }
 
@@ -352,17 +339,6 @@ impl<'a> Pose<'a> {
     #[must_use]
     pub fn position(&self, s: &Station) -> Vector2<f64> {
         self.frames.origin[s.link] + self.to_base(s.link, &self.local(s))
-    }
-    /// Position of a pin in frame 0 (a pin on a link sits on its deformed axis).
-    ///
-    /// # Panics
-    /// If the pin names a link the arm does not have ([`PlanarArm::check_pin`] first).
-    #[must_use]
-    pub fn pin_position(&self, pin: &Pin) -> Vector2<f64> {
-        match *pin {
-            Pin::Ground(p) => p,
-            Pin::Link { link, x } => self.position(&self.arm.station_unchecked(link, x)),
-        }
     }
     /// `(cos φ_i, sin φ_i)`.
     #[must_use]

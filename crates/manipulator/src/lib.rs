@@ -42,29 +42,45 @@
 //! block ([`ArmReactions`]). [`ArmScene`] wires them into a graph; [`KINDS`] offers the
 //! scene to model files as the composite kind `manipulator.planar_arm`.
 
-pub mod actuator;
+// Dependencies run one way, down this list: a module uses only modules of its own group
+// and of the groups above it.
+
+// Screw algebra (section 2)
+pub mod screw;
+
+// The arm (section 3.1)
 pub mod arm;
-mod cholesky;
-pub mod elements;
-pub mod gravity;
-pub mod hessians;
 pub mod joint;
-pub mod kinds;
-pub mod kinematics;
-pub mod kinetic_forces;
 pub mod link;
-pub mod lumped_mass;
-pub mod mass_matrix;
 pub mod mode_shape;
 pub mod pin;
 pub mod projection;
 pub mod quadrature;
-pub mod reactions;
-pub mod reference;
-pub mod scene;
-pub mod screw;
 pub mod shape_integrals;
+
+// Dynamics (section 3.2)
+mod cholesky;
+pub mod gravity;
+pub mod kinematics;
+pub mod kinetic_forces;
+pub mod mass_matrix;
 pub mod stiffness;
+
+// Actuators and lumped masses (sections 3.3, 4.2)
+pub mod actuator;
+pub mod lumped_mass;
+
+// Second derivatives (for the exact Jacobian), reaction forces (section 5)
+pub mod hessians;
+pub mod reactions;
+
+// The per-station reference of the tests
+pub mod reference;
+
+// Bond-graph elements (section 4), the scene, the kinds
+pub mod elements;
+pub mod kinds;
+pub mod scene;
 
 pub use actuator::LinearActuator;
 pub use arm::{Frames, PlanarArm, Pose, Station};

@@ -58,6 +58,18 @@ impl PinPoint {
 }
 
 impl PlanarArm {
+    /// Check a pin lies on the arm (or is a finite ground point).
+    pub fn check_pin(&self, pin: &Pin) -> Result<(), ParamError> {
+        match *pin {
+            Pin::Ground(p) => {
+                ParamError::finite("pin.x", p.x)?;
+                ParamError::finite("pin.y", p.y)?;
+                Ok(())
+            }
+            Pin::Link { link, x } => self.station(link, x).map(|_| ()),
+        }
+    }
+
     /// Resolve `pin` on this arm (checks it lies on the arm).
     pub fn resolve_pin(&self, pin: &Pin) -> Result<PinPoint, ParamError> {
         self.check_pin(pin)?;
@@ -69,6 +81,17 @@ impl PlanarArm {
 }
 
 impl Pose<'_> {
+    /// Position of a pin in frame 0 (a pin on a link sits on its deformed axis).
+    ///
+    /// # Panics
+    /// If the pin names a link the arm does not have ([`PlanarArm::check_pin`] first).
+    #[must_use]
+    pub fn pin_position(&self, pin: &Pin) -> Vector2<f64> {
+        match *pin {
+            Pin::Ground(p) => p,
+            Pin::Link { link, x } => self.position(&self.arm().station_unchecked(link, x)),
+        }
+    }
     /// Position of a resolved pin in frame 0.
     #[must_use]
     pub fn pin_point_position(&self, pin: &PinPoint) -> Vector2<f64> {

@@ -23,7 +23,7 @@ use bondgraph::{
 };
 use nalgebra::{DMatrix, Vector2};
 
-use super::last_argument::LastArgument;
+use super::at_last_q::AtLastQ;
 use super::mtf_law;
 use crate::actuator::LinearActuator;
 use crate::arm::{Frames, PlanarArm};
@@ -40,41 +40,72 @@ pub struct ActuatorTransformer {
     ws: RefCell<Modulus>,
 }
 
-/// τ_b and the lengths at the last configuration q.
+/// τ_b and the lengths at the last configuration q, `∇²l_c` at the configuration of the
+/// last partials, and the frames and scratch they are computed in.
 #[derive(Debug)]
 struct Modulus {
-    q: LastArgument,
     frames: Frames,
-    tau: DMatrix<f64>,
-    lengths: Vec<f64>,
-    /// The configuration of the last partials, `∇²l_c` there, and scratch.
-    jac_q: LastArgument,
-    hessians: Vec<DMatrix<f64>>,
+    lengths: AtLastQ<Lengths>,
+    hessians: AtLastQ<Vec<DMatrix<f64>>>,
     jd: Vec<Vector2<f64>>,
 }
 
+/// `τ_b = ∂l/∂q` (column c for actuator c) and the lengths l.
+#[derive(Debug)]
+struct Lengths {
+    tau: DMatrix<f64>,
+    l: Vec<f64>,
+}
+
 impl Modulus {
-    fn update(&mut self, arm: &PlanarArm, pins: &[(PinPoint, PinPoint)], q: &[f64]) {
-        if self.q.is_same(q) {
-            return;
-        }
-        let pose = arm.pose_in(self.q.get(), &mut self.frames);
-        let n = arm.n();
-        for (c, (a, b)) in pins.iter().enumerate() {
-            let column = &mut self.tau.as_mut_slice()[c * n..(c + 1) * n];
-            self.lengths[c] = pose.actuator_length(a, b, column);
-        }
+    /// τ_b and the lengths at q.
+    fn lengths(&mut self, arm: &PlanarArm, pins: &[(PinPoint, PinPoint)], q: &[f64]) -> &Lengths {
+        let Self {
+            frames, lengths, ..
+        } = self;
+        lengths_at(lengths, frames, arm, pins, q)
     }
 
-    fn update_hessians(&mut self, arm: &PlanarArm, pins: &[(PinPoint, PinPoint)], q: &[f64]) {
-        if self.jac_q.is_same(q) {
-            return;
-        }
-        let pose = arm.pose_in(self.jac_q.get(), &mut self.frames);
-        for ((a, b), h) in pins.iter().zip(&mut self.hessians) {
-            pose.actuator_length_hessian(a, b, &mut self.jd, h);
-        }
+    /// τ_b, the lengths and their Hessians `∇²l_c` at q.
+    fn with_hessians(
+        &mut self,
+        arm: &PlanarArm,
+        pins: &[(PinPoint, PinPoint)],
+        q: &[f64],
+    ) -> (&Lengths, &[DMatrix<f64>]) {
+        let Self {
+            frames,
+            lengths,
+            hessians,
+            jd,
+        } = self;
+        let lengths = lengths_at(lengths, frames, arm, pins, q);
+        let (_, hessians) = hessians.get_or_update(q, |q, hessians| {
+            let pose = arm.pose_in(q, frames);
+            for ((a, b), h) in pins.iter().zip(hessians) {
+                pose.actuator_length_hessian(a, b, jd, h);
+            }
+        });
+        (lengths, hessians)
     }
+}
+
+fn lengths_at<'a>(
+    lengths: &'a mut AtLastQ<Lengths>,
+    frames: &mut Frames,
+    arm: &PlanarArm,
+    pins: &[(PinPoint, PinPoint)],
+    q: &[f64],
+) -> &'a Lengths {
+    let n = arm.n();
+    let (_, lengths) = lengths.get_or_update(q, |q, Lengths { tau, l }| {
+        let pose = arm.pose_in(q, frames);
+        for (c, (a, b)) in pins.iter().enumerate() {
+            let column = &mut tau.as_mut_slice()[c * n..(c + 1) * n];
+            l[c] = pose.actuator_length(a, b, column);
+        }
+    });
+    lengths
 }
 
 impl ActuatorTransformer {
@@ -99,12 +130,15 @@ impl ActuatorTransformer {
         let n = arm.n();
         Ok(Self {
             ws: RefCell::new(Modulus {
-                q: LastArgument::new(n),
                 frames: arm.frames(),
-                tau: DMatrix::zeros(n, acts.len()),
-                lengths: vec![0.0; acts.len()],
-                jac_q: LastArgument::new(n),
-                hessians: vec![DMatrix::zeros(n, n); acts.len()],
+                lengths: AtLastQ::new(
+                    n,
+                    Lengths {
+                        tau: DMatrix::zeros(n, acts.len()),
+                        l: vec![0.0; acts.len()],
+                    },
+                ),
+                hessians: AtLastQ::new(n, vec![DMatrix::zeros(n, n); acts.len()]),
                 jd: vec![Vector2::zeros(); n],
             }),
             arm,
@@ -163,19 +197,19 @@ impl Element for ActuatorTransformer {
     }
     fn eval(&self, stage: usize, io: &mut Io<'_>) {
         let mut ws = self.ws.borrow_mut();
-        ws.update(&self.arm, &self.pins, io.input(0));
+        let Lengths { tau, l } = ws.lengths(&self.arm, &self.pins, io.input(0));
         let n = self.pins.len();
         match stage {
-            0 => mtf_law::set_effort(io, &ws.tau),
-            1 => mtf_law::set_flow(io, &ws.tau),
+            0 => mtf_law::set_effort(io, tau),
+            1 => mtf_law::set_flow(io, tau),
             2 => {
-                for (c, lc) in ws.lengths.iter().enumerate() {
+                for (c, lc) in l.iter().enumerate() {
                     io.set_y(c, 0, *lc);
                 }
             }
             _ => {
                 for c in 0..n {
-                    let column = ws.tau.column(c);
+                    let column = tau.column(c);
                     let ldot: f64 = column.iter().zip(io.flow(0)).map(|(t, f)| t * f).sum();
                     io.set_y(n + c, 0, ldot);
                 }
@@ -184,25 +218,22 @@ impl Element for ActuatorTransformer {
     }
     fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
         let mut ws = self.ws.borrow_mut();
-        ws.update(&self.arm, &self.pins, io.input(0));
-        ws.update_hessians(&self.arm, &self.pins, io.input(0));
+        let (Lengths { tau, .. }, hessians) = ws.with_hessians(&self.arm, &self.pins, io.input(0));
         let (n, n_act) = (self.arm.n(), self.pins.len());
         match stage {
             0 => {
-                mtf_law::effort_partials(jac, &ws.tau);
+                mtf_law::effort_partials(jac, tau);
                 for k in 0..n {
                     let row = jac.row(Slot::Effort(0), k);
                     for l in 0..n {
-                        let v: f64 = (0..n_act)
-                            .map(|c| io.e(1, c) * ws.hessians[c][(k, l)])
-                            .sum();
+                        let v: f64 = (0..n_act).map(|c| io.e(1, c) * hessians[c][(k, l)]).sum();
                         jac.set(row, jac.input_col(0, l), v);
                     }
                 }
             }
             1 => {
-                mtf_law::flow_partials(jac, &ws.tau);
-                for (c, h) in ws.hessians.iter().enumerate() {
+                mtf_law::flow_partials(jac, tau);
+                for (c, h) in hessians.iter().enumerate() {
                     let row = jac.row(Slot::Flow(1), c);
                     for l in 0..n {
                         let v: f64 = (0..n).map(|k| h[(k, l)] * io.f_in(0, k)).sum();
@@ -214,17 +245,17 @@ impl Element for ActuatorTransformer {
                 for c in 0..n_act {
                     let row = jac.row(Slot::Output(c), 0);
                     for l in 0..n {
-                        jac.set(row, jac.input_col(0, l), ws.tau[(l, c)]);
+                        jac.set(row, jac.input_col(0, l), tau[(l, c)]);
                     }
                 }
             }
             _ => {
                 // ldot_c = Σ_k τ_b[k, c] · (bond flow)_k, bond flow = sign · f_in
                 let sign = io.sign(0);
-                for (c, h) in ws.hessians.iter().enumerate() {
+                for (c, h) in hessians.iter().enumerate() {
                     let row = jac.row(Slot::Output(n_act + c), 0);
                     for k in 0..n {
-                        jac.set(row, jac.flow_col(0, k), sign * ws.tau[(k, c)]);
+                        jac.set(row, jac.flow_col(0, k), sign * tau[(k, c)]);
                     }
                     for l in 0..n {
                         let v: f64 = (0..n).map(|k| h[(k, l)] * io.flow(0)[k]).sum();

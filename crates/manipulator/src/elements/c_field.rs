@@ -16,7 +16,7 @@ use bondgraph::{
 };
 use nalgebra::{DMatrix, DVector};
 
-use super::last_argument::LastArgument;
+use super::at_last_q::AtLastQ;
 use crate::arm::{Frames, PlanarArm};
 use crate::kinematics::ArmKinematics;
 
@@ -29,31 +29,45 @@ pub struct ArmCompliance {
     ws: RefCell<Workspace>,
 }
 
-/// G(q) and V_g(q) at the last configuration.
+/// G(q) and V_g(q) at the last configuration, `∂²V_g/∂q²` at the configuration of the last
+/// partials, and the frames both are computed in.
 #[derive(Debug)]
 struct Workspace {
-    q: LastArgument,
     frames: Frames,
+    gravity: AtLastQ<Gravity>,
+    gravity_hessian: AtLastQ<DMatrix<f64>>,
+}
+
+/// The generalized gravity forces G and the potential V_g.
+#[derive(Debug)]
+struct Gravity {
     g: Vec<f64>,
     v_g: f64,
-    /// The configuration of the last partials, and `∂²V_g/∂q²` there.
-    jac_q: LastArgument,
-    gravity_hessian: DMatrix<f64>,
 }
 
 impl Workspace {
-    fn update(&mut self, arm: &PlanarArm, q: &[f64]) {
-        if !self.q.is_same(q) {
-            let kin = ArmKinematics::new(arm.pose_in(self.q.get(), &mut self.frames));
-            self.v_g = kin.gravity_into(&mut self.g);
-        }
+    /// G and V_g at q, and q.
+    fn gravity(&mut self, arm: &PlanarArm, q: &[f64]) -> (&[f64], &Gravity) {
+        let Self {
+            frames, gravity, ..
+        } = self;
+        gravity.get_or_update(q, |q, gr| {
+            let kin = ArmKinematics::new(arm.pose_in(q, frames));
+            gr.v_g = kin.gravity_into(&mut gr.g);
+        })
     }
 
-    fn update_hessian(&mut self, arm: &PlanarArm, q: &[f64]) {
-        if !self.jac_q.is_same(q) {
-            let kin = ArmKinematics::new(arm.pose_in(self.jac_q.get(), &mut self.frames));
-            kin.gravity_hessian_into(&mut self.gravity_hessian);
-        }
+    /// `∂²V_g/∂q²` at q.
+    fn gravity_hessian(&mut self, arm: &PlanarArm, q: &[f64]) -> &DMatrix<f64> {
+        let Self {
+            frames,
+            gravity_hessian,
+            ..
+        } = self;
+        let (_, h) = gravity_hessian.get_or_update(q, |q, h| {
+            ArmKinematics::new(arm.pose_in(q, frames)).gravity_hessian_into(h);
+        });
+        h
     }
 }
 
@@ -65,12 +79,15 @@ impl ArmCompliance {
         Self {
             k: arm.stiffness_matrix(),
             ws: RefCell::new(Workspace {
-                q: LastArgument::new(n),
                 frames: arm.frames(),
-                g: vec![0.0; n],
-                v_g: 0.0,
-                jac_q: LastArgument::new(n),
-                gravity_hessian: DMatrix::zeros(n, n),
+                gravity: AtLastQ::new(
+                    n,
+                    Gravity {
+                        g: vec![0.0; n],
+                        v_g: 0.0,
+                    },
+                ),
+                gravity_hessian: AtLastQ::new(n, DMatrix::zeros(n, n)),
             }),
             arm,
             q_signal: q_signal.to_owned(),
@@ -122,10 +139,9 @@ impl Element for ArmCompliance {
     }
     fn eval(&self, stage: usize, io: &mut Io<'_>) {
         let mut ws = self.ws.borrow_mut();
-        ws.update(&self.arm, io.input(0));
-        let q = ws.q.get();
+        let (q, gravity) = ws.gravity(&self.arm, io.input(0));
         if stage == 0 {
-            for (k, gk) in ws.g.iter().enumerate() {
+            for (k, gk) in gravity.g.iter().enumerate() {
                 let kq: f64 = q
                     .iter()
                     .enumerate()
@@ -134,26 +150,25 @@ impl Element for ArmCompliance {
                 io.set_e(0, k, kq - gk);
             }
         } else {
-            io.set_y(0, 0, ws.v_g + PlanarArm::strain_energy(&self.k, q));
+            io.set_y(0, 0, gravity.v_g + PlanarArm::strain_energy(&self.k, q));
         }
     }
     fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
         let n = self.arm.n();
         let mut ws = self.ws.borrow_mut();
-        ws.update(&self.arm, io.input(0));
         if stage == 0 {
-            ws.update_hessian(&self.arm, io.input(0));
+            let gravity_hessian = ws.gravity_hessian(&self.arm, io.input(0));
             for k in 0..n {
                 let row = jac.row(Slot::Effort(0), k);
                 for l in 0..n {
-                    let v = self.k[(k, l)] + ws.gravity_hessian[(k, l)];
+                    let v = self.k[(k, l)] + gravity_hessian[(k, l)];
                     jac.set(row, jac.input_col(0, l), v);
                 }
             }
         } else {
             let row = jac.row(Slot::Output(0), 0);
-            let q = ws.q.get();
-            for (l, gl) in ws.g.iter().enumerate() {
+            let (q, gravity) = ws.gravity(&self.arm, io.input(0));
+            for (l, gl) in gravity.g.iter().enumerate() {
                 let kq: f64 = q
                     .iter()
                     .enumerate()

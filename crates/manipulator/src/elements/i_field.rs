@@ -48,7 +48,7 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::arm::z_cross;
 
-use super::last_argument::LastArgument;
+use super::at_last_q::AtLastQ;
 use crate::arm::{Frames, PlanarArm, Station};
 use crate::cholesky::Cholesky;
 use crate::kinematics::ArmKinematics;
@@ -66,21 +66,31 @@ pub struct ArmInertia {
     ws: RefCell<Motion>,
 }
 
-/// Everything computed at one state (p, q), in buffers allocated once.
+/// Everything computed at one state x = (p, q), in buffers allocated once: what the
+/// right-hand side needs at the last state, Ṁu at the last state `udot` was asked at, the
+/// partials at the state of the last partials; the frames they are computed in and scratch.
 #[derive(Debug)]
 struct Motion {
-    state: LastArgument,
     frames: Frames,
+    at_state: AtLastQ<AtState>,
+    mdot_u: AtLastQ<Vec<f64>>,
+    partials: AtLastQ<Partials>,
+    udot: Vec<f64>,
+}
+
+/// M, its factor, u = M⁻¹p, E and T at one state.
+#[derive(Debug)]
+struct AtState {
     m: DMatrix<f64>,
     factor: Cholesky,
     u: Vec<f64>,
     e: Vec<f64>,
-    mdot_u: Vec<f64>,
-    mdot_u_valid: bool,
-    udot: Vec<f64>,
     kinetic: f64,
-    /// The state of the last partials, and M⁻¹, B, M⁻¹B and `H − BᵀM⁻¹B` there.
-    jac_state: LastArgument,
+}
+
+/// M⁻¹, B, M⁻¹B and `H − BᵀM⁻¹B` at one state.
+#[derive(Debug)]
+struct Partials {
     minv: DMatrix<f64>,
     b: DMatrix<f64>,
     minv_b: DMatrix<f64>,
@@ -98,41 +108,102 @@ impl Motion {
     fn new(arm: &PlanarArm) -> Self {
         let n = arm.n();
         Self {
-            state: LastArgument::new(2 * n),
             frames: arm.frames(),
-            m: DMatrix::zeros(n, n),
-            factor: Cholesky::new(n),
-            u: vec![0.0; n],
-            e: vec![0.0; n],
-            mdot_u: vec![0.0; n],
-            mdot_u_valid: false,
+            at_state: AtLastQ::new(
+                2 * n,
+                AtState {
+                    m: DMatrix::zeros(n, n),
+                    factor: Cholesky::new(n),
+                    u: vec![0.0; n],
+                    e: vec![0.0; n],
+                    kinetic: 0.0,
+                },
+            ),
+            mdot_u: AtLastQ::new(2 * n, vec![0.0; n]),
+            partials: AtLastQ::new(
+                2 * n,
+                Partials {
+                    minv: DMatrix::zeros(n, n),
+                    b: DMatrix::zeros(n, n),
+                    minv_b: DMatrix::zeros(n, n),
+                    dpdot_dq: DMatrix::zeros(n, n),
+                },
+            ),
             udot: vec![0.0; n],
-            kinetic: 0.0,
-            jac_state: LastArgument::new(2 * n),
-            minv: DMatrix::zeros(n, n),
-            b: DMatrix::zeros(n, n),
-            minv_b: DMatrix::zeros(n, n),
-            dpdot_dq: DMatrix::zeros(n, n),
         }
     }
 
-    /// M, its factor, u = M⁻¹p, E and T at the state x = (p, q), unless x is the last one.
-    fn update(&mut self, arm: &PlanarArm, x: &[f64]) {
-        if self.state.is_same(x) {
-            return;
-        }
+    /// What is computed at the state x, and x.
+    fn state(&mut self, arm: &PlanarArm, x: &[f64]) -> (&[f64], &AtState) {
         let Self {
-            state,
+            frames, at_state, ..
+        } = self;
+        AtState::at(at_state, frames, arm, x)
+    }
+
+    /// What is computed at the state x, and the partials there.
+    fn partials(&mut self, arm: &PlanarArm, x: &[f64]) -> (&AtState, &Partials) {
+        let Self {
             frames,
+            at_state,
+            partials,
+            ..
+        } = self;
+        let (_, state) = AtState::at(at_state, frames, arm, x);
+        let (_, partials) =
+            partials.get_or_update(x, |x, partials| partials.compute(arm, x, state, frames));
+        (state, partials)
+    }
+
+    /// `u̇ = M⁻¹(e + E − Ṁu)` at the state x with the effort e received (`effort(k)`).
+    fn accelerations(
+        &mut self,
+        arm: &PlanarArm,
+        x: &[f64],
+        effort: impl Fn(usize) -> f64,
+    ) -> &[f64] {
+        let Self {
+            frames,
+            at_state,
+            mdot_u,
+            udot,
+            ..
+        } = self;
+        let (_, state) = AtState::at(at_state, frames, arm, x);
+        let (_, mdot_u) = mdot_u.get_or_update(x, |x, mdot_u| {
+            let kin = ArmKinematics::new(arm.pose_in(&x[arm.n()..], frames));
+            // (E again into udot, overwritten below)
+            kin.kinetic_terms_into(&state.u, udot, Some(mdot_u));
+        });
+        for (k, a) in udot.iter_mut().enumerate() {
+            *a = effort(k) + state.e[k] - mdot_u[k];
+        }
+        state.factor.solve_in_place(udot);
+        udot
+    }
+}
+
+impl AtState {
+    /// The value of `cache` at the state x (updated unless x is its last state), and x.
+    fn at<'c>(
+        cache: &'c mut AtLastQ<Self>,
+        frames: &mut Frames,
+        arm: &PlanarArm,
+        x: &[f64],
+    ) -> (&'c [f64], &'c Self) {
+        cache.get_or_update(x, |x, s| s.compute(arm, x, frames))
+    }
+
+    /// M, its factor, u = M⁻¹p, E and T at the state x = (p, q).
+    fn compute(&mut self, arm: &PlanarArm, x: &[f64], frames: &mut Frames) {
+        let Self {
             m,
             factor,
             u,
             e,
-            mdot_u_valid,
             kinetic,
-            ..
         } = self;
-        let (p, q) = state.get().split_at(arm.n());
+        let (p, q) = x.split_at(arm.n());
         let kin = ArmKinematics::new(arm.pose_in(q, frames));
         kin.mass_matrix_into(m);
         factor.factor(m);
@@ -140,28 +211,21 @@ impl Motion {
         factor.solve_in_place(u);
         kin.kinetic_terms_into(u, e, None);
         *kinetic = 0.5 * u.iter().zip(p).map(|(a, b)| a * b).sum::<f64>();
-        *mdot_u_valid = false;
     }
+}
 
-    /// M⁻¹, B, M⁻¹B and `H − BᵀM⁻¹B` at the last state (after [`update`](Self::update)).
-    fn partials(&mut self, arm: &PlanarArm) {
+impl Partials {
+    /// M⁻¹, B, M⁻¹B and `H − BᵀM⁻¹B` at the state x, with what is computed there.
+    fn compute(&mut self, arm: &PlanarArm, x: &[f64], state: &AtState, frames: &mut Frames) {
         let Self {
-            state,
-            frames,
-            factor,
-            u,
-            jac_state,
             minv,
             b,
             minv_b,
             dpdot_dq,
-            ..
         } = self;
-        if jac_state.is_same(state.get()) {
-            return;
-        }
+        let AtState { factor, u, .. } = state;
         let n = arm.n();
-        let kin = ArmKinematics::new(arm.pose_in(&state.get()[n..], frames));
+        let kin = ArmKinematics::new(arm.pose_in(&x[n..], frames));
         kin.kinetic_partials_into(u, b, dpdot_dq);
         for (k, col) in minv.as_mut_slice().chunks_mut(n).enumerate() {
             col.fill(0.0);
@@ -178,17 +242,6 @@ impl Motion {
                 dpdot_dq[(r, c)] -= bt_x;
             }
         }
-    }
-
-    /// Ṁu at the last state.
-    fn velocity_products(&mut self, arm: &PlanarArm) {
-        if self.mdot_u_valid {
-            return;
-        }
-        let q = &self.state.get()[arm.n()..];
-        let kin = ArmKinematics::new(arm.pose_in(q, &mut self.frames));
-        kin.kinetic_terms_into(&self.u, &mut self.udot, Some(&mut self.mdot_u));
-        self.mdot_u_valid = true;
     }
 }
 
@@ -356,35 +409,27 @@ impl Element for ArmInertia {
     fn eval(&self, stage: usize, io: &mut Io<'_>) {
         let n = self.arm.n();
         let mut ws = self.ws.borrow_mut();
-        ws.update(&self.arm, io.states());
         match stage {
             0 => {
-                for (k, &uk) in ws.u.iter().enumerate() {
+                let (_, state) = ws.state(&self.arm, io.states());
+                for (k, &uk) in state.u.iter().enumerate() {
                     io.set_f_in(0, k, uk);
                     io.set_y(OUT_U, k, uk);
                 }
             }
             1 => {
-                ws.velocity_products(&self.arm);
-                let Motion {
-                    factor,
-                    e,
-                    mdot_u,
-                    udot,
-                    ..
-                } = &mut *ws;
-                for k in 0..n {
-                    udot[k] = io.e(0, k) + e[k] - mdot_u[k];
-                }
-                factor.solve_in_place(udot);
+                let udot = ws.accelerations(&self.arm, io.states(), |k| io.e(0, k));
                 for (k, &a) in udot.iter().enumerate() {
                     io.set_y(OUT_UDOT, k, a);
                 }
             }
             2 => {
-                io.set_y(OUT_T, 0, ws.kinetic);
-                let Motion { state, frames, .. } = &mut *ws;
-                let pose = self.arm.pose_in(&state.get()[n..], frames);
+                let Motion {
+                    frames, at_state, ..
+                } = &mut *ws;
+                let (x, state) = AtState::at(at_state, frames, &self.arm, io.states());
+                io.set_y(OUT_T, 0, state.kinetic);
+                let pose = self.arm.pose_in(&x[n..], frames);
                 for i in 0..self.arm.n_links() {
                     let end = pose.origin(i + 1);
                     let w = self.mid[i].as_ref().map_or(0.0, |s| pose.deflection(s));
@@ -394,9 +439,10 @@ impl Element for ArmInertia {
                 }
             }
             _ => {
+                let (x, state) = ws.state(&self.arm, io.states());
                 let first = self.first_named_output();
                 for (j, (_, _, index)) in self.named.iter().enumerate() {
-                    let (q, v) = index.map_or((0.0, 0.0), |k| (ws.state.get()[n + k], ws.u[k]));
+                    let (q, v) = index.map_or((0.0, 0.0), |k| (x[n + k], state.u[k]));
                     io.set_y(first + 2 * j, 0, q);
                     io.set_y(first + 2 * j + 1, 0, v);
                 }
@@ -406,29 +452,35 @@ impl Element for ArmInertia {
     fn derivatives(&self, io: &Io<'_>, dx: &mut [f64]) {
         let n = self.arm.n();
         let mut ws = self.ws.borrow_mut();
-        ws.update(&self.arm, io.states());
+        let (_, state) = ws.state(&self.arm, io.states());
         for k in 0..n {
-            dx[k] = io.e(0, k) + ws.e[k];
-            dx[n + k] = ws.u[k];
+            dx[k] = io.e(0, k) + state.e[k];
+            dx[n + k] = state.u[k];
         }
     }
     fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
         let n = self.arm.n();
         let mut ws = self.ws.borrow_mut();
-        ws.update(&self.arm, io.states());
-        ws.partials(&self.arm);
+        let Motion {
+            frames,
+            at_state,
+            partials,
+            ..
+        } = &mut *ws;
+        let (x, state) = AtState::at(at_state, frames, &self.arm, io.states());
+        let (_, d) = partials.get_or_update(x, |x, d| d.compute(&self.arm, x, state, frames));
         // ∂u_k/∂(p, q) into row `row`.
-        let speed_row = |jac: &mut LocalJacobian<'_>, row: usize, k: usize, ws: &Motion| {
+        let speed_row = |jac: &mut LocalJacobian<'_>, row: usize, k: usize| {
             for c in 0..n {
-                jac.set(row, jac.state_col(c), ws.minv[(k, c)]);
-                jac.set(row, jac.state_col(n + c), -ws.minv_b[(k, c)]);
+                jac.set(row, jac.state_col(c), d.minv[(k, c)]);
+                jac.set(row, jac.state_col(n + c), -d.minv_b[(k, c)]);
             }
         };
         match stage {
             0 => {
                 for k in 0..n {
-                    speed_row(jac, jac.row(Slot::Flow(0), k), k, &ws);
-                    speed_row(jac, jac.row(Slot::Output(OUT_U), k), k, &ws);
+                    speed_row(jac, jac.row(Slot::Flow(0), k), k);
+                    speed_row(jac, jac.row(Slot::Output(OUT_U), k), k);
                 }
             }
             1 => return false,
@@ -436,11 +488,10 @@ impl Element for ArmInertia {
                 // T: ∂T/∂p = u, ∂T/∂q|_p = −E
                 let row = jac.row(Slot::Output(OUT_T), 0);
                 for c in 0..n {
-                    jac.set(row, jac.state_col(c), ws.u[c]);
-                    jac.set(row, jac.state_col(n + c), -ws.e[c]);
+                    jac.set(row, jac.state_col(c), state.u[c]);
+                    jac.set(row, jac.state_col(n + c), -state.e[c]);
                 }
-                let Motion { state, frames, .. } = &mut *ws;
-                let pose = self.arm.pose_in(&state.get()[n..], frames);
+                let pose = self.arm.pose_in(&x[n..], frames);
                 for i in 0..self.arm.n_links() {
                     let end = pose.origin(i + 1);
                     let (rx, ry) = (
@@ -467,7 +518,7 @@ impl Element for ArmInertia {
                     if let Some(k) = *index {
                         let row = jac.row(Slot::Output(first + 2 * j), 0);
                         jac.set(row, jac.state_col(n + k), 1.0);
-                        speed_row(jac, jac.row(Slot::Output(first + 2 * j + 1), 0), k, &ws);
+                        speed_row(jac, jac.row(Slot::Output(first + 2 * j + 1), 0), k);
                     }
                 }
             }
@@ -477,28 +528,26 @@ impl Element for ArmInertia {
     fn derivative_partials(&self, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
         let n = self.arm.n();
         let mut ws = self.ws.borrow_mut();
-        ws.update(&self.arm, io.states());
-        ws.partials(&self.arm);
+        let (_, d) = ws.partials(&self.arm, io.states());
         for r in 0..n {
             // ṗ = e + E(q, u(p, q))
             let row = jac.derivative_row(r);
             jac.set(row, jac.effort_col(0, r), 1.0);
             for c in 0..n {
-                jac.set(row, jac.state_col(c), ws.minv_b[(c, r)]);
-                jac.set(row, jac.state_col(n + c), ws.dpdot_dq[(r, c)]);
+                jac.set(row, jac.state_col(c), d.minv_b[(c, r)]);
+                jac.set(row, jac.state_col(n + c), d.dpdot_dq[(r, c)]);
             }
             // q̇ = u(p, q)
             let row = jac.derivative_row(n + r);
             for c in 0..n {
-                jac.set(row, jac.state_col(c), ws.minv[(r, c)]);
-                jac.set(row, jac.state_col(n + c), -ws.minv_b[(r, c)]);
+                jac.set(row, jac.state_col(c), d.minv[(r, c)]);
+                jac.set(row, jac.state_col(n + c), -d.minv_b[(r, c)]);
             }
         }
         true
     }
     fn stored_energy(&self, x: &[f64]) -> Option<f64> {
         let mut ws = self.ws.borrow_mut();
-        ws.update(&self.arm, x);
-        Some(ws.kinetic)
+        Some(ws.state(&self.arm, x).1.kinetic)
     }
 }

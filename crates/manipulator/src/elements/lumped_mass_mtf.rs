@@ -20,7 +20,7 @@ use bondgraph::{
 };
 use nalgebra::{DMatrix, Vector2};
 
-use super::last_argument::LastArgument;
+use super::at_last_q::AtLastQ;
 use super::mtf_law;
 use crate::arm::{Frames, PlanarArm, Station};
 use crate::pin::{Pin, PinPoint};
@@ -34,12 +34,11 @@ pub struct LumpedMassTransformer {
     ws: RefCell<Modulus>,
 }
 
-/// `J_cᵀ` at the last configuration q.
+/// `J_cᵀ` at the last configuration q, and the frames it is computed in.
 #[derive(Debug)]
 struct Modulus {
-    q: LastArgument,
     frames: Frames,
-    jt: DMatrix<f64>,
+    jt: AtLastQ<DMatrix<f64>>,
 }
 
 impl LumpedMassTransformer {
@@ -66,9 +65,8 @@ impl LumpedMassTransformer {
         let n = arm.n();
         Ok(Self {
             ws: RefCell::new(Modulus {
-                q: LastArgument::new(n),
                 frames: arm.frames(),
-                jt: DMatrix::zeros(n, 2 * pins.len()),
+                jt: AtLastQ::new(n, DMatrix::zeros(n, 2 * pins.len())),
             }),
             arm,
             stations,
@@ -78,13 +76,23 @@ impl LumpedMassTransformer {
 }
 
 impl Modulus {
-    /// `J_cᵀ` (n × 2m, eq. 71) at q: column 2k, 2k+1 the x, y velocity Jacobian of pin k.
-    fn update(&mut self, arm: &PlanarArm, stations: &[Station], q: &[f64]) {
-        if self.q.is_same(q) {
-            return;
-        }
-        let pose = arm.pose_in(self.q.get(), &mut self.frames);
-        let jt = &mut self.jt;
+    /// `J_cᵀ` (n × 2m, eq. 71) at q: column 2k, 2k+1 the x, y velocity Jacobian of pin k;
+    /// and q.
+    fn jt(&mut self, arm: &PlanarArm, stations: &[Station], q: &[f64]) -> (&[f64], &DMatrix<f64>) {
+        let Self { frames, jt } = self;
+        jt_at(jt, frames, arm, stations, q)
+    }
+}
+
+fn jt_at<'a>(
+    jt: &'a mut AtLastQ<DMatrix<f64>>,
+    frames: &mut Frames,
+    arm: &PlanarArm,
+    stations: &[Station],
+    q: &[f64],
+) -> (&'a [f64], &'a DMatrix<f64>) {
+    jt.get_or_update(q, |q, jt| {
+        let pose = arm.pose_in(q, frames);
         jt.fill(0.0);
         for (k, s) in stations.iter().enumerate() {
             pose.point_jacobian(s, |i, col| {
@@ -92,7 +100,7 @@ impl Modulus {
                 jt[(i, 2 * k + 1)] = col.y;
             });
         }
-    }
+    })
 }
 
 impl Element for LumpedMassTransformer {
@@ -119,18 +127,18 @@ impl Element for LumpedMassTransformer {
     }
     fn eval(&self, stage: usize, io: &mut Io<'_>) {
         let mut ws = self.ws.borrow_mut();
-        ws.update(&self.arm, &self.stations, io.input(0));
+        let (_, jt) = ws.jt(&self.arm, &self.stations, io.input(0));
         if stage == 0 {
-            mtf_law::set_effort(io, &ws.jt);
+            mtf_law::set_effort(io, jt);
         } else {
-            mtf_law::set_flow(io, &ws.jt);
+            mtf_law::set_flow(io, jt);
         }
     }
     fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
         let mut ws = self.ws.borrow_mut();
-        ws.update(&self.arm, &self.stations, io.input(0));
-        let Modulus { q, frames, jt } = &mut *ws;
-        let pose = self.arm.pose_in(q.get(), frames);
+        let Modulus { frames, jt } = &mut *ws;
+        let (q, jt) = jt_at(jt, frames, &self.arm, &self.stations, io.input(0));
+        let pose = self.arm.pose_in(q, frames);
         if stage == 0 {
             mtf_law::effort_partials(jac, jt);
             for (p, s) in self.stations.iter().enumerate() {

@@ -17,9 +17,9 @@
 //! corresponding rate (l̇, pin velocities).
 
 mod actuator_mtf;
+mod at_last_q;
 mod c_field;
 mod i_field;
-mod last_argument;
 mod lumped_gravity;
 mod lumped_mass_mtf;
 mod lumped_masses;
