@@ -31,23 +31,29 @@ fn allocations(eqs: &StateEquations) -> ((usize, usize), (usize, usize)) {
     let mut jac = DMatrix::zeros(n, n);
     eqs.rhs(0.0, &x0, &mut dx);
     eqs.jacobian(0.0, &x0, &mut jac);
-    let region = Region::new(GLOBAL);
-    for (k, x) in states.iter().enumerate() {
-        eqs.rhs(1e-3 * k as f64, x, &mut dx);
-    }
-    let rhs = region.change();
-    let region = Region::new(GLOBAL);
-    for (k, x) in states.iter().take(10).enumerate() {
-        eqs.jacobian(1e-3 * k as f64, x, &mut jac);
-    }
-    let jacobian = region.change();
-    (
-        (rhs.allocations + rhs.reallocations, rhs.bytes_allocated),
-        (
+    // The counter sees every thread of the process (the harness's threads allocate now and
+    // then); an allocation of rhs or the Jacobian shows in every pass, so keep the fewest.
+    let mut best = ((usize::MAX, 0), (usize::MAX, 0));
+    for _ in 0..3 {
+        let region = Region::new(GLOBAL);
+        for (k, x) in states.iter().enumerate() {
+            eqs.rhs(1e-3 * k as f64, x, &mut dx);
+        }
+        let rhs = region.change();
+        let region = Region::new(GLOBAL);
+        for (k, x) in states.iter().take(10).enumerate() {
+            eqs.jacobian(1e-3 * k as f64, x, &mut jac);
+        }
+        let jacobian = region.change();
+        best.0 = best
+            .0
+            .min((rhs.allocations + rhs.reallocations, rhs.bytes_allocated));
+        best.1 = best.1.min((
             jacobian.allocations + jacobian.reallocations,
             jacobian.bytes_allocated,
-        ),
-    )
+        ));
+    }
+    best
 }
 
 fn check(name: &str) {

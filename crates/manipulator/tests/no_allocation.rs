@@ -64,26 +64,35 @@ fn no_allocation_per_evaluation_after_the_first() {
         let mut dx = vec![0.0; n];
         eqs.rhs(0.0, &x0, &mut dx);
         eqs.evaluate(0.0, &x0);
-        let region = Region::new(GLOBAL);
-        for (k, x) in states.iter().enumerate() {
-            eqs.rhs(0.01 * k as f64, x, &mut dx);
+        // The counter sees every thread of the process: the test harness's own threads
+        // allocate now and then. An allocation of the rhs would show in every pass, so the
+        // fewest over three passes is what the evaluation itself allocates.
+        let mut rhs = (usize::MAX, usize::MAX);
+        let mut evaluate = (usize::MAX, usize::MAX);
+        for _ in 0..3 {
+            let region = Region::new(GLOBAL);
+            for (k, x) in states.iter().enumerate() {
+                eqs.rhs(0.01 * k as f64, x, &mut dx);
+            }
+            let c = region.change();
+            rhs = rhs.min((c.allocations, c.reallocations));
+            let region = Region::new(GLOBAL);
+            for (k, x) in states.iter().enumerate() {
+                eqs.evaluate(0.01 * k as f64, x);
+            }
+            let c = region.change();
+            evaluate = evaluate.min((c.allocations, c.reallocations));
         }
-        let rhs = region.change();
-        let region = Region::new(GLOBAL);
-        for (k, x) in states.iter().enumerate() {
-            eqs.evaluate(0.01 * k as f64, x);
-        }
-        let evaluate = region.change();
         assert!(dx.iter().all(|d| d.is_finite()));
         assert_eq!(
-            (rhs.allocations, rhs.reallocations),
+            rhs,
             (0, 0),
-            "{modes} modes: rhs allocated ({rhs:?})"
+            "{modes} modes: rhs (allocations, reallocations)"
         );
         assert_eq!(
-            (evaluate.allocations, evaluate.reallocations),
+            evaluate,
             (0, 0),
-            "{modes} modes: evaluate allocated ({evaluate:?})"
+            "{modes} modes: evaluate (allocations, reallocations)"
         );
     }
 }
