@@ -6,6 +6,9 @@ use std::process::ExitCode;
 
 use bg_model::inspect;
 use bg_sim::registry;
+use serde_json::json;
+
+use super::json::{problems, Format};
 
 /// The options of `bg-sim check` (its summary is on `Command::Check` in main.rs).
 #[derive(clap::Args)]
@@ -15,11 +18,47 @@ pub struct Args {
     /// Override a value of the model file (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
+    /// text, or json (elements, states, problems and notes as one JSON document).
+    #[arg(long, value_enum, default_value_t = Format::Text)]
+    pub format: Format,
 }
 
 /// `bg-sim check`.
 pub fn command(a: &Args) -> ExitCode {
-    check(&a.model, &a.set)
+    match a.format {
+        Format::Text => check(&a.model, &a.set),
+        Format::Json => check_json(&a.model, &a.set),
+    }
+}
+
+/// `check --format json`: `{file, ok, elements: [{name, kind, line}], states: [{name,
+/// initial}], problems: [..], notes: [..]}` with problems and notes as [`problems`] writes
+/// them; exit 1 if there are problems.
+fn check_json(path: &Path, set: &[String]) -> ExitCode {
+    let report = inspect(path, &registry(), set);
+    let elements: Vec<_> = report
+        .elements
+        .iter()
+        .map(|(name, kind, line)| json!({"name": name, "kind": kind, "line": line}))
+        .collect();
+    let states: Vec<_> = report
+        .states
+        .iter()
+        .map(|(name, v)| json!({"name": name, "initial": v}))
+        .collect();
+    crate::report::document(&json!({
+        "file": path.display().to_string(),
+        "ok": report.problems.is_empty(),
+        "elements": elements,
+        "states": states,
+        "problems": problems(&report.problems),
+        "notes": problems(&report.notes),
+    }));
+    if report.problems.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    }
 }
 
 fn check(path: &Path, set: &[String]) -> ExitCode {

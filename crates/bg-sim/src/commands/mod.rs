@@ -9,6 +9,7 @@ pub mod bench;
 pub mod check;
 pub mod compare;
 pub mod graph;
+pub mod json;
 pub mod kinds;
 pub mod modes;
 pub mod plot;

@@ -6,9 +6,12 @@ mod output;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use bg_model::Model;
+use bg_model::{CheckResult, Model, ModelError};
 use bg_sim::registry;
-use bondgraph::{Method, SimulationError};
+use bondgraph::{Method, SimulationError, Statistics};
+use serde_json::json;
+
+use super::json::{problems, Format};
 
 use super::plot::{plot, PlotWhat};
 use super::{interrupt_on_signals, BAD_INPUT, FAILED};
@@ -49,6 +52,10 @@ pub struct Args {
     /// Format of those figures: png, svg or both.
     #[arg(long, value_name = "FORMAT", default_value = "png")]
     pub plot_format: String,
+    /// text, or json (the run's outcome, statistics, checks and problems as one JSON
+    /// document on stdout; the text report goes to stderr).
+    #[arg(long, value_enum, default_value_t = Format::Text)]
+    pub format: Format,
 }
 
 /// `bg-sim run`.
@@ -65,7 +72,12 @@ pub fn command(a: Args) -> ExitCode {
         quiet,
         plots,
         plot_format,
+        format,
     } = a;
+    if format == Format::Json {
+        crate::report::keep_stdout_for_document();
+    }
+    let mut facts = Facts::default();
     let (code, written) = run(
         &model,
         output,
@@ -76,7 +88,11 @@ pub fn command(a: Args) -> ExitCode {
         dt_out,
         &set,
         quiet,
+        &mut facts,
     );
+    if format == Format::Json {
+        crate::report::document(&facts.json(&model, written.as_deref()));
+    }
     match (plots, written) {
         (Some(dir), Some(csv)) => match plot(
             &csv,
@@ -103,23 +119,31 @@ fn run(
     dt_out: Option<f64>,
     set: &[String],
     quiet: bool,
+    facts: &mut Facts,
 ) -> (ExitCode, Option<PathBuf>) {
-    let refuse = |m: String| {
+    let refuse = |facts: &mut Facts, m: String| {
+        facts.refused = Some(m.clone());
         tell!("error: {m}");
         (ExitCode::from(BAD_INPUT), None)
     };
     let mut model = match Model::load(path, &registry(), set) {
         Ok(m) => m,
-        Err(e) => return refuse(e.to_string()),
+        Err(e) => {
+            facts.problems.push(e.clone());
+            return refuse(facts, e.to_string());
+        }
     };
     if let Some(s) = solver {
         match Method::parse(s) {
             Some(m) => model.settings.method = m,
             None => {
-                return refuse(format!(
-                    "unknown solver `{s}`\n  hint: solvers are {}",
-                    Method::names()
-                ))
+                return refuse(
+                    facts,
+                    format!(
+                        "unknown solver `{s}`\n  hint: solvers are {}",
+                        Method::names()
+                    ),
+                )
             }
         }
     }
@@ -136,7 +160,7 @@ fn run(
         model.settings.dt_out = v;
     }
     if let Err(e) = model.settings.validate() {
-        return refuse(e.to_string());
+        return refuse(facts, e.to_string());
     }
     let out_path = output.unwrap_or_else(|| {
         let stem = path
@@ -148,7 +172,7 @@ fn run(
     // Before any work: the destination must be writable and must not be the model itself.
     let mut sink = match open_output(&out_path, &partial, path, &model) {
         Ok(s) => s,
-        Err(m) => return refuse(m),
+        Err(m) => return refuse(facts, m),
     };
     if !quiet {
         let s = &model.settings;
@@ -184,7 +208,7 @@ fn run(
         Ok(r) => r,
         Err(e) => {
             let _ = std::fs::remove_file(&partial);
-            return refuse(e.to_string());
+            return refuse(facts, e.to_string());
         }
     };
     // The rows still buffered; a failure here (a full disk) makes the run incomplete.
@@ -200,16 +224,24 @@ fn run(
         ),
         (None, Ok(())) => None,
     };
+    facts.stats = Some(outcome.stats.clone());
+    facts.rows = sink.rows;
+    facts.columns = outcome.trajectory.columns.len();
+    facts.t_final = Some(outcome.t_final);
+    facts.stopped.clone_from(&error);
     let target = if error.is_none() {
         // complete: the rows become OUT.csv in one rename (a reader never sees half a file),
         // and no partial file is left beside it
         if let Err(e) = std::fs::rename(&partial, &out_path) {
-            return refuse(format!(
-                "cannot rename {} to {}: {e} (the complete results are in {})",
-                partial.display(),
-                out_path.display(),
-                partial.display()
-            ));
+            return refuse(
+                facts,
+                format!(
+                    "cannot rename {} to {}: {e} (the complete results are in {})",
+                    partial.display(),
+                    out_path.display(),
+                    partial.display()
+                ),
+            );
         }
         out_path.clone()
     } else {
@@ -255,6 +287,7 @@ fn run(
         }
         code = ExitCode::from(FAILED);
     } else {
+        facts.checks.clone_from(&checks);
         for r in checks {
             let status = if r.passed { "ok  " } else { "FAIL" };
             if !quiet || !r.passed {
@@ -273,4 +306,84 @@ fn run(
         }
     }
     (code, Some(target))
+}
+
+/// What `run` did, for `--format json`.
+#[derive(Default)]
+pub struct Facts {
+    /// The model file's problems, if it did not load.
+    problems: Vec<ModelError>,
+    /// Why the run did not start (bad model, option or destination).
+    refused: Option<String>,
+    /// Solver work, once the run has run.
+    stats: Option<Statistics>,
+    /// Rows written and columns per row.
+    rows: usize,
+    columns: usize,
+    /// Time reached.
+    t_final: Option<f64>,
+    /// Why the run stopped early, if it did.
+    stopped: Option<String>,
+    /// The `[[check]]` results (of a run that reached its end).
+    checks: Vec<CheckResult>,
+}
+
+impl Facts {
+    /// `{file, outcome, error, results, rows, columns, t_final, statistics: {steps, rhs,
+    /// jacobians, jacobians_assembled, lu, error_test_failures, newton_iterations,
+    /// newton_failures, events, wall_s}, checks: [{value, passed, max_error, t_worst, tol,
+    /// points}], problems: [..]}`; `outcome` is `complete`, `checks-failed`, `failed` (the run
+    /// stopped early or its file could not be finished: the rows so far are in `results`, the
+    /// partial file) or `refused` (nothing ran: `problems` has the model's, if any).
+    fn json(&self, model: &Path, results: Option<&Path>) -> serde_json::Value {
+        let outcome = if self.stats.is_none() {
+            "refused"
+        } else if self.refused.is_some() || self.stopped.is_some() {
+            "failed"
+        } else if self.checks.iter().any(|c| !c.passed) {
+            "checks-failed"
+        } else {
+            "complete"
+        };
+        let statistics = self.stats.as_ref().map(|s| {
+            json!({
+                "steps": s.steps,
+                "rhs": s.rhs_evals,
+                "jacobians": s.jac_evals,
+                "jacobians_assembled": s.jac_assemblies,
+                "lu": s.lu_factorisations,
+                "error_test_failures": s.error_test_failures,
+                "newton_iterations": s.newton_iterations,
+                "newton_failures": s.newton_failures,
+                "events": s.events,
+                "wall_s": s.wall_time.as_secs_f64(),
+            })
+        });
+        let checks: Vec<_> = self
+            .checks
+            .iter()
+            .map(|c| {
+                json!({
+                    "value": c.value,
+                    "passed": c.passed,
+                    "max_error": c.max_error,
+                    "t_worst": c.t_worst,
+                    "tol": c.tol,
+                    "points": c.points,
+                })
+            })
+            .collect();
+        json!({
+            "file": model.display().to_string(),
+            "outcome": outcome,
+            "error": self.refused.as_ref().or(self.stopped.as_ref()),
+            "results": results.map(|p| p.display().to_string()),
+            "rows": self.rows,
+            "columns": self.columns,
+            "t_final": self.t_final,
+            "statistics": statistics,
+            "checks": checks,
+            "problems": problems(&self.problems),
+        })
+    }
 }
