@@ -1,0 +1,111 @@
+//! `bg-sim check`: list a model's elements, bonds with causal strokes, states, scene
+//! switches and problems.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use bg_model::inspect;
+use bg_sim::registry;
+use serde_json::json;
+
+use super::json::{problems, Format};
+
+/// The options of `bg-sim check` (its summary is on `Command::Check` in main.rs).
+#[derive(clap::Args)]
+pub struct Args {
+    /// The model file.
+    pub model: PathBuf,
+    /// Override a value of the model file (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    /// text, or json (elements, states, problems and notes as one JSON document).
+    #[arg(long, value_enum, default_value_t = Format::Text)]
+    pub format: Format,
+}
+
+/// `bg-sim check`.
+pub fn command(a: &Args) -> ExitCode {
+    match a.format {
+        Format::Text => check(&a.model, &a.set),
+        Format::Json => check_json(&a.model, &a.set),
+    }
+}
+
+/// `check --format json`: `{file, ok, elements: [{name, kind, line}], states: [{name,
+/// initial}], problems: [..], notes: [..]}` with problems and notes as [`problems`] writes
+/// them; exit 1 if there are problems.
+fn check_json(path: &Path, set: &[String]) -> ExitCode {
+    let report = inspect(path, &registry(), set);
+    let elements: Vec<_> = report
+        .elements
+        .iter()
+        .map(|(name, kind, line)| json!({"name": name, "kind": kind, "line": line}))
+        .collect();
+    let states: Vec<_> = report
+        .states
+        .iter()
+        .map(|(name, v)| json!({"name": name, "initial": v}))
+        .collect();
+    crate::report::document(&json!({
+        "file": path.display().to_string(),
+        "ok": report.problems.is_empty(),
+        "elements": elements,
+        "states": states,
+        "problems": problems(&report.problems),
+        "notes": problems(&report.notes),
+    }));
+    if report.problems.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    }
+}
+
+fn check(path: &Path, set: &[String]) -> ExitCode {
+    let report = inspect(path, &registry(), set);
+    if !report.elements.is_empty() {
+        say!("elements ({}):", report.elements.len());
+        for (name, kind, line) in &report.elements {
+            say!("  {name:<20} {kind:<20} line {line}");
+        }
+    }
+    if !report.bonds.is_empty() {
+        say!(
+            "bonds ({}), `|` marks the causal stroke (the end that receives the effort):",
+            report.bonds.len()
+        );
+        for b in &report.bonds {
+            say!("  {b}");
+        }
+    }
+    if !report.states.is_empty() {
+        say!("states ({}):", report.states.len());
+        for (name, v) in &report.states {
+            say!("  {name:<24} initial {v}");
+        }
+    }
+    if !report.scene.is_empty() {
+        say!(
+            "scene switches ({}, {} scenes; `bg-sim reduce` searches them), richest choice first:",
+            report.scene.switches.len(),
+            report.scene.grid_size()
+        );
+        for sw in &report.scene.switches {
+            let choices: Vec<&str> = sw.choices.iter().map(|c| c.label.as_str()).collect();
+            say!("  {:<20} {} = {}", sw.name, sw.set, choices.join(" | "));
+        }
+    }
+    for n in &report.notes {
+        say!("  note: {n}");
+    }
+    if report.problems.is_empty() {
+        say!("no problems found");
+        ExitCode::SUCCESS
+    } else {
+        say!("problems ({}):", report.problems.len());
+        for p in &report.problems {
+            say!("  error: {p}");
+        }
+        ExitCode::from(1)
+    }
+}

@@ -1,0 +1,373 @@
+//! The sweep spec: its values, design and metrics ([`Spec`]), and reading it from TOML
+//! ([`parse_spec`], [`parse_metric`]).
+
+use bg_model::expr::Expr;
+
+use super::design::run_count;
+use super::{err, SweepError, MAX_RUNS};
+
+/// A value given to one `--set` path.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Value {
+    /// A number.
+    Num(f64),
+    /// Text (a solver name, an expression).
+    Text(String),
+}
+
+impl Value {
+    /// As written in `--set` and in the summary.
+    #[must_use]
+    pub fn render(&self) -> String {
+        match self {
+            // `{:?}` is the shortest text that reads back as the same f64, and valid TOML
+            Self::Num(v) => format!("{v:?}"),
+            Self::Text(s) => s.clone(),
+        }
+    }
+}
+
+/// The values of one swept parameter.
+#[derive(Clone, Debug)]
+pub enum Values {
+    /// Explicit values.
+    List(Vec<Value>),
+    /// `n` values from `from` to `to`, both included; spaced evenly, or evenly in log.
+    Range {
+        /// First value.
+        from: f64,
+        /// Last value.
+        to: f64,
+        /// How many (grid); ignored by a Latin hypercube, which samples the interval.
+        n: usize,
+        /// Spaced evenly in log10 (both ends > 0).
+        log: bool,
+    },
+}
+
+/// How the parameters' values combine into runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Design {
+    /// Every combination (the first parameter varies slowest).
+    Grid,
+    /// A Latin-hypercube sample of `samples` points, reproducible from `seed`.
+    Lhs {
+        /// Number of runs.
+        samples: usize,
+        /// Seed of the generator.
+        seed: u64,
+    },
+}
+
+/// What to reduce a column expression to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Reduction {
+    /// Largest value.
+    Max,
+    /// Smallest value.
+    Min,
+    /// Mean over the output rows.
+    Mean,
+    /// Root mean square over the output rows.
+    Rms,
+    /// Value at the first row.
+    Initial,
+    /// Value at the last row.
+    Final,
+    /// Time of the largest value.
+    TimeOfMax,
+    /// Time of the smallest value.
+    TimeOfMin,
+    /// First time the value crosses the level (interpolated); empty if it never does.
+    FirstCrossing,
+}
+
+const REDUCTIONS: &[(&str, Reduction)] = &[
+    ("max", Reduction::Max),
+    ("min", Reduction::Min),
+    ("mean", Reduction::Mean),
+    ("rms", Reduction::Rms),
+    ("initial", Reduction::Initial),
+    ("final", Reduction::Final),
+    ("time_of_max", Reduction::TimeOfMax),
+    ("time_of_min", Reduction::TimeOfMin),
+    ("first_crossing", Reduction::FirstCrossing),
+];
+
+/// One metric kept per run.
+#[derive(Clone, Debug)]
+pub struct Metric {
+    /// Column name in the summary.
+    pub name: String,
+    /// The reduction.
+    pub reduction: Reduction,
+    /// The expression over output columns, `t` and parameters.
+    pub expr: Expr,
+    /// The level of `first_crossing`.
+    pub level: f64,
+    /// As written in the spec.
+    pub source: String,
+}
+
+/// A parsed sweep spec.
+#[derive(Clone, Debug)]
+pub struct Spec {
+    /// `--set` paths and their values, in the order of the file.
+    pub parameters: Vec<(String, Values)>,
+    /// How they combine.
+    pub design: Design,
+    /// What to keep per run.
+    pub metrics: Vec<Metric>,
+    /// Also write every run's full results to `runs/`.
+    pub keep_runs: bool,
+}
+
+/// Parse a sweep spec; `file` names it in errors.
+pub fn parse_spec(file: &str, text: &str) -> Result<Spec, SweepError> {
+    let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
+        err(
+            file,
+            format!("not a valid TOML sweep spec: {}", e.message()),
+        )
+    })?;
+    for key in table.keys() {
+        if !["sweep", "parameters", "metrics"].contains(&key.as_str()) {
+            return Err(err(
+                file,
+                format!(
+                    "unknown section `{key}`; a sweep spec has [sweep], [parameters] and [metrics]"
+                ),
+            ));
+        }
+    }
+    let sweep = match table.get("sweep") {
+        None => toml::Table::new(),
+        Some(toml::Value::Table(t)) => t.clone(),
+        Some(_) => return Err(err(file, "`sweep` must be a table")),
+    };
+    let int = |k: &str| -> Result<Option<u64>, SweepError> {
+        match sweep.get(k) {
+            None => Ok(None),
+            Some(toml::Value::Integer(i)) if *i >= 0 => Ok(u64::try_from(*i).ok()),
+            Some(_) => Err(err(file, format!("[sweep] {k} must be a whole number ≥ 0"))),
+        }
+    };
+    for k in sweep.keys() {
+        if !["design", "samples", "seed", "keep_runs"].contains(&k.as_str()) {
+            return Err(err(
+                file,
+                format!("[sweep] has no key `{k}`; keys: design, samples, seed, keep_runs"),
+            ));
+        }
+    }
+    let design = match sweep.get("design").map(toml::Value::as_str) {
+        None | Some(Some("grid")) => {
+            if sweep.contains_key("samples") {
+                return Err(err(file, "[sweep] samples is for design = \"lhs\""));
+            }
+            Design::Grid
+        }
+        Some(Some("lhs")) => {
+            let samples =
+                int("samples")?.ok_or_else(|| err(file, "design = \"lhs\" needs samples = N"))?;
+            let samples = usize::try_from(samples).unwrap_or(usize::MAX);
+            if samples == 0 || samples > MAX_RUNS {
+                return Err(err(file, format!("samples must be 1 to {MAX_RUNS}")));
+            }
+            Design::Lhs {
+                samples,
+                seed: int("seed")?.unwrap_or(0),
+            }
+        }
+        Some(_) => return Err(err(file, "[sweep] design is \"grid\" or \"lhs\"")),
+    };
+    let keep_runs = match sweep.get("keep_runs") {
+        None => false,
+        Some(toml::Value::Boolean(b)) => *b,
+        Some(_) => return Err(err(file, "[sweep] keep_runs is true or false")),
+    };
+
+    let mut parameters = Vec::new();
+    if let Some(p) = table.get("parameters") {
+        let toml::Value::Table(p) = p else {
+            return Err(err(file, "`parameters` must be a table"));
+        };
+        for (name, v) in p {
+            let path = if name.contains('.') {
+                name.clone()
+            } else {
+                format!("parameters.{name}")
+            };
+            parameters.push((path, parse_values(file, name, v)?));
+        }
+    }
+    if parameters.is_empty() {
+        return Err(err(
+            file,
+            "[parameters] is empty: name at least one value to sweep (k = [1.0, 2.0])",
+        ));
+    }
+
+    let mut metrics = Vec::new();
+    if let Some(m) = table.get("metrics") {
+        let toml::Value::Table(m) = m else {
+            return Err(err(file, "`metrics` must be a table"));
+        };
+        for (name, v) in m {
+            let Some(src) = v.as_str() else {
+                return Err(err(
+                    file,
+                    format!("metric `{name}` must be a string such as \"max(x)\""),
+                ));
+            };
+            metrics.push(parse_metric(name, src).map_err(|m| err(file, m))?);
+        }
+    }
+    if design == Design::Grid {
+        if let Some((k, _)) = parameters
+            .iter()
+            .find(|(_, v)| matches!(v, Values::Range { n: 0, .. }))
+        {
+            return Err(err(
+                file,
+                format!("`{k}`: a range in a grid needs n, the number of values"),
+            ));
+        }
+    }
+    let spec = Spec {
+        parameters,
+        design,
+        metrics,
+        keep_runs,
+    };
+    let n = run_count(&spec);
+    if n > MAX_RUNS {
+        return Err(err(
+            file,
+            format!("the grid has {n} runs, more than {MAX_RUNS}; use design = \"lhs\""),
+        ));
+    }
+    Ok(spec)
+}
+
+fn parse_values(file: &str, name: &str, v: &toml::Value) -> Result<Values, SweepError> {
+    let scalar = |x: &toml::Value| -> Result<Value, SweepError> {
+        match x {
+            toml::Value::Float(f) if f.is_finite() => Ok(Value::Num(*f)),
+            #[allow(clippy::cast_precision_loss)]
+            toml::Value::Integer(i) => Ok(Value::Num(*i as f64)),
+            toml::Value::String(s) => Ok(Value::Text(s.clone())),
+            _ => Err(err(
+                file,
+                format!("`{name}`: values are finite numbers or strings"),
+            )),
+        }
+    };
+    let num = |t: &toml::Table, k: &str| -> Result<f64, SweepError> {
+        match t.get(k) {
+            Some(toml::Value::Float(f)) if f.is_finite() => Ok(*f),
+            #[allow(clippy::cast_precision_loss)]
+            Some(toml::Value::Integer(i)) => Ok(*i as f64),
+            _ => Err(err(
+                file,
+                format!("`{name}`: `{k}` must be a finite number"),
+            )),
+        }
+    };
+    match v {
+        toml::Value::Array(a) if !a.is_empty() => Ok(Values::List(
+            a.iter().map(scalar).collect::<Result<_, _>>()?,
+        )),
+        toml::Value::Array(_) => Err(err(file, format!("`{name}`: the list is empty"))),
+        toml::Value::Table(t) => {
+            for k in t.keys() {
+                if !["from", "to", "n", "scale"].contains(&k.as_str()) {
+                    return Err(err(
+                        file,
+                        format!("`{name}`: a range has from, to, n and scale, not `{k}`"),
+                    ));
+                }
+            }
+            let (from, to) = (num(t, "from")?, num(t, "to")?);
+            let n = match t.get("n") {
+                None => 0,
+                Some(toml::Value::Integer(i)) if *i >= 1 => usize::try_from(*i).unwrap_or(0),
+                Some(_) => return Err(err(file, format!("`{name}`: n must be ≥ 1"))),
+            };
+            let log = match t.get("scale").map(toml::Value::as_str) {
+                None | Some(Some("linear")) => false,
+                Some(Some("log")) => true,
+                Some(_) => {
+                    return Err(err(
+                        file,
+                        format!("`{name}`: scale is \"linear\" or \"log\""),
+                    ))
+                }
+            };
+            if log && (from <= 0.0 || to <= 0.0) {
+                return Err(err(
+                    file,
+                    format!("`{name}`: scale = \"log\" needs from and to > 0"),
+                ));
+            }
+            Ok(Values::Range { from, to, n, log })
+        }
+        other => Ok(Values::List(vec![scalar(other)?])),
+    }
+}
+
+/// Parse one metric, `REDUCTION(EXPR)` or `first_crossing(EXPR, LEVEL)`.
+pub fn parse_metric(name: &str, src: &str) -> Result<Metric, String> {
+    let bad = |m: &str| {
+        format!(
+            "metric `{name}` = \"{}\": {m}; write REDUCTION(EXPR) with a reduction among {}",
+            bg_model::error::clip(src),
+            REDUCTIONS
+                .iter()
+                .map(|r| r.0)
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    };
+    let s = src.trim();
+    let (head, rest) = s.split_once('(').ok_or_else(|| bad("no `(`"))?;
+    let inner = rest
+        .strip_suffix(')')
+        .ok_or_else(|| bad("it must end with `)`"))?;
+    let reduction = REDUCTIONS
+        .iter()
+        .find(|r| r.0 == head.trim())
+        .map(|r| r.1)
+        .ok_or_else(|| bad(&format!("unknown reduction `{}`", head.trim())))?;
+    // split at the last comma outside parentheses
+    let mut depth = 0i32;
+    let mut split = None;
+    for (i, c) in inner.char_indices() {
+        match c {
+            '(' => depth += 1,
+            ')' => depth -= 1,
+            ',' if depth == 0 => split = Some(i),
+            _ => {}
+        }
+    }
+    let (expr_src, level) = match (reduction, split) {
+        (Reduction::FirstCrossing, Some(i)) => {
+            let level = Expr::parse(&inner[i + 1..])
+                .map_err(|e| bad(&e.to_string()))?
+                .eval(&|_| None)
+                .map_err(|e| bad(&format!("the level must be a number: {e}")))?;
+            (&inner[..i], level)
+        }
+        (Reduction::FirstCrossing, None) => return Err(bad("first_crossing(EXPR, LEVEL)")),
+        (_, Some(_)) => return Err(bad("this reduction takes one argument")),
+        (_, None) => (inner, 0.0),
+    };
+    let expr = Expr::parse(expr_src).map_err(|e| bad(&e.to_string()))?;
+    Ok(Metric {
+        name: name.to_owned(),
+        reduction,
+        expr,
+        level,
+        source: src.to_owned(),
+    })
+}
