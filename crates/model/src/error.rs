@@ -107,6 +107,14 @@ impl ModelError {
         self.hint = Some(clip_to(&hint.into(), MAX_MESSAGE));
         self
     }
+    /// With `hint` if there is one, else as it is.
+    #[must_use]
+    pub(crate) fn or_hint(self, hint: Option<String>) -> Self {
+        match hint {
+            Some(h) => self.hint(h),
+            None => self,
+        }
+    }
     /// With the error underneath.
     #[must_use]
     pub fn with_source(mut self, source: impl std::error::Error + Send + Sync + 'static) -> Self {
