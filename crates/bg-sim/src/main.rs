@@ -477,14 +477,10 @@ fn dispatch(command: Command) -> ExitCode {
                 tell!("error: unknown search `{search}`\n  hint: auto, grid or greedy");
                 return ExitCode::from(BAD_INPUT);
             };
-            let method = match solver.as_deref().map(|s| (s, Method::parse(s))) {
-                None => None,
-                Some((_, Some(m))) => Some(m),
-                Some((s, None)) => {
-                    tell!(
-                        "error: unknown solver `{s}`\n  hint: solvers are {}",
-                        Method::names()
-                    );
+            let method = match solver.as_deref().map(bg_model::solver).transpose() {
+                Ok(m) => m,
+                Err(e) => {
+                    tell!("error: {e}\n  hint: {}", e.hint());
                     return ExitCode::from(BAD_INPUT);
                 }
             };
@@ -738,13 +734,10 @@ fn bench(a: &BenchArgs<'_>) -> ExitCode {
     }
     let mut methods = Vec::new();
     for s in a.solvers {
-        match Method::parse(s) {
-            Some(m) => methods.push(m),
-            None => {
-                tell!(
-                    "error: unknown solver `{s}`\n  hint: solvers are {}",
-                    Method::names()
-                );
+        match bg_model::solver(s) {
+            Ok(m) => methods.push(m),
+            Err(e) => {
+                tell!("error: {e}\n  hint: {}", e.hint());
                 return ExitCode::from(2);
             }
         }
@@ -1060,14 +1053,9 @@ fn run(
         Err(e) => return refuse(e.to_string()),
     };
     if let Some(s) = solver {
-        match Method::parse(s) {
-            Some(m) => model.settings.method = m,
-            None => {
-                return refuse(format!(
-                    "unknown solver `{s}`\n  hint: solvers are {}",
-                    Method::names()
-                ))
-            }
+        match bg_model::solver(s) {
+            Ok(m) => model.settings.method = m,
+            Err(e) => return refuse(format!("{e}\n  hint: {}", e.hint())),
         }
     }
     if let Some(v) = rtol {

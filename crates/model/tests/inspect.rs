@@ -45,7 +45,10 @@ fn every_problem_with_its_line() {
     );
     assert!(out.problems[0].hint.as_deref().unwrap().contains("q0"));
     // the elements that were built are listed
-    assert!(out.elements.iter().any(|(n, _, l)| n == "damper" && *l == 9));
+    assert!(out
+        .elements
+        .iter()
+        .any(|(n, _, l)| n == "damper" && *l == 9));
     // Model::load reports the first
     let first = bg_model::Model::load(&path, &Registry::with_core(), &[]).unwrap_err();
     assert_eq!(first, out.problems[0]);
