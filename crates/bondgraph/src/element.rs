@@ -284,8 +284,10 @@ pub struct Limit {
     pub lower: f64,
     /// Upper bound.
     pub upper: f64,
-    /// What reaching it means and what to do, e.g. "the piston left its stroke; add an end stop".
+    /// What reaching it means, e.g. "the piston left its stroke".
     pub message: String,
+    /// What to do about it, e.g. "add an end stop".
+    pub hint: Option<String>,
 }
 
 /// A state whose minimum the simulator records over a run, at every accepted step.

@@ -593,20 +593,24 @@ impl StateEquations {
         check_same_shape(&n.name, n.element.as_ref(), element)?;
         let causality: Vec<PortCausality> =
             self.layouts[id].ports.iter().map(|p| p.causality).collect();
-        let err = |message: String| {
+        let err = |message: String, hint: Option<&str>| {
             Err(GraphError::Replacement {
                 element: n.name.clone(),
                 message,
+                hint: hint.map(str::to_owned),
             })
         };
         if !element.causal_rule(causality.len()).admits(&causality) {
-            return err(format!(
-                "the new {} does not accept the causality assigned to it ({causality:?}); hint: a resistance switched to 0 cannot stay in conductance causality, use a small value instead",
-                element.kind()
-            ));
+            return err(
+                format!(
+                    "the new {} does not accept the causality assigned to it ({causality:?})",
+                    element.kind()
+                ),
+                Some("a resistance switched to 0 cannot stay in conductance causality, use a small value instead"),
+            );
         }
         if element.stages(&causality) != n.element.stages(&causality) {
-            return err("the new element computes in different stages".into());
+            return err("the new element computes in different stages".into(), None);
         }
         Ok(())
     }

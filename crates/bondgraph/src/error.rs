@@ -1,5 +1,6 @@
 //! Typed errors of the bond-graph core. Each variant carries the culprit (element, bond,
-//! time) and, where one helps, a hint; only the CLI flattens them into text.
+//! time) and, where one helps, a hint as data (`hint()`, apart from `message()`); `Display`
+//! writes both, `message; hint: hint`.
 
 use thiserror::Error;
 
@@ -96,17 +97,19 @@ impl ParamError {
 }
 
 /// The graph's structure is inconsistent.
+///
+/// [`message`](Self::message) says what is wrong, [`hint`](Self::hint) what to do about it
+/// (as data: a caller that shows hints apart takes them from there); `Display` writes
+/// `message; hint: hint`.
 #[derive(Clone, Debug, Error, PartialEq)]
 #[non_exhaustive]
 pub enum GraphError {
     /// Two elements share a name.
-    #[error("element name `{name}` is used twice; hint: names must be unique")]
     DuplicateName {
         /// The name.
         name: String,
     },
     /// A port index or name does not exist.
-    #[error("element `{element}` ({kind}) has no port `{port}`; its ports are: {available}")]
     NoSuchPort {
         /// Element name.
         element: String,
@@ -118,7 +121,6 @@ pub enum GraphError {
         available: String,
     },
     /// A port already has a bond.
-    #[error("port `{port}` of element `{element}` ({kind}) already has a bond; hint: connect several bonds through a 0- or 1-junction")]
     PortInUse {
         /// Element name.
         element: String,
@@ -128,7 +130,6 @@ pub enum GraphError {
         port: String,
     },
     /// An element has no free port left for another bond.
-    #[error("element `{element}` ({kind}) has {n_ports} port(s), all already bonded; hint: connect several bonds through a junction")]
     NoFreePort {
         /// Element name.
         element: String,
@@ -138,7 +139,6 @@ pub enum GraphError {
         n_ports: usize,
     },
     /// A port has no bond.
-    #[error("port `{port}` of element `{element}` ({kind}) is not connected; hint: every port of an element needs exactly one bond")]
     Unconnected {
         /// Element name.
         element: String,
@@ -148,13 +148,11 @@ pub enum GraphError {
         port: String,
     },
     /// A junction with no bonds.
-    #[error("junction `{element}` has no bonds; hint: remove it or connect it")]
     EmptyJunction {
         /// Element name.
         element: String,
     },
     /// Dimensions disagree.
-    #[error("dimension mismatch at `{element}`: {message}")]
     DimensionMismatch {
         /// Element name.
         element: String,
@@ -162,7 +160,6 @@ pub enum GraphError {
         message: String,
     },
     /// A signal name does not resolve.
-    #[error("element `{element}` reads signal `{signal}`, which does not exist; hint: {hint}")]
     UnknownSignal {
         /// Reading element.
         element: String,
@@ -172,9 +169,6 @@ pub enum GraphError {
         hint: String,
     },
     /// A signal has the wrong dimension.
-    #[error(
-        "element `{element}` reads signal `{signal}` of dimension {found}, but needs {expected}"
-    )]
     SignalDimension {
         /// Reading element.
         element: String,
@@ -186,21 +180,20 @@ pub enum GraphError {
         found: usize,
     },
     /// An element named in an API call does not exist.
-    #[error("no element named `{name}`")]
     UnknownElement {
         /// The name.
         name: String,
     },
     /// A replacement element (scheduled event) does not have the shape of the original.
-    #[error("element `{element}` cannot be replaced: {message}")]
     Replacement {
         /// Element name.
         element: String,
         /// What differs.
         message: String,
+        /// What to do, if something can be done.
+        hint: Option<String>,
     },
     /// An element's stages do not compute what its causality requires (a bug in that element).
-    #[error("element `{element}` ({kind}) breaks the Element contract: {message}")]
     Contract {
         /// Element name.
         element: String,
@@ -211,12 +204,106 @@ pub enum GraphError {
     },
 }
 
-/// Causality assignment or equation ordering failed.
+impl GraphError {
+    /// What is wrong, without the hint.
+    #[must_use]
+    pub fn message(&self) -> String {
+        match self {
+            Self::DuplicateName { name } => format!("element name `{name}` is used twice"),
+            Self::NoSuchPort {
+                element,
+                kind,
+                port,
+                available,
+            } => format!(
+                "element `{element}` ({kind}) has no port `{port}`; its ports are: {available}"
+            ),
+            Self::PortInUse {
+                element,
+                kind,
+                port,
+            } => format!("port `{port}` of element `{element}` ({kind}) already has a bond"),
+            Self::NoFreePort {
+                element,
+                kind,
+                n_ports,
+            } => format!(
+                "element `{element}` ({kind}) has {n_ports} port(s), all already bonded"
+            ),
+            Self::Unconnected {
+                element,
+                kind,
+                port,
+            } => format!("port `{port}` of element `{element}` ({kind}) is not connected"),
+            Self::EmptyJunction { element } => format!("junction `{element}` has no bonds"),
+            Self::DimensionMismatch { element, message } => {
+                format!("dimension mismatch at `{element}`: {message}")
+            }
+            Self::UnknownSignal {
+                element, signal, ..
+            } => format!("element `{element}` reads signal `{signal}`, which does not exist"),
+            Self::SignalDimension {
+                element,
+                signal,
+                expected,
+                found,
+            } => format!(
+                "element `{element}` reads signal `{signal}` of dimension {found}, but needs {expected}"
+            ),
+            Self::UnknownElement { name } => format!("no element named `{name}`"),
+            Self::Replacement {
+                element, message, ..
+            } => format!("element `{element}` cannot be replaced: {message}"),
+            Self::Contract {
+                element,
+                kind,
+                message,
+            } => format!("element `{element}` ({kind}) breaks the Element contract: {message}"),
+        }
+    }
+
+    /// What to do about it, where the core knows.
+    #[must_use]
+    pub fn hint(&self) -> Option<String> {
+        let h = match self {
+            Self::DuplicateName { .. } => "names must be unique",
+            Self::PortInUse { .. } => "connect several bonds through a 0- or 1-junction",
+            Self::NoFreePort { .. } => "connect several bonds through a junction",
+            Self::Unconnected { .. } => "every port of an element needs exactly one bond",
+            Self::EmptyJunction { .. } => "remove it or connect it",
+            Self::UnknownSignal { hint, .. } => hint,
+            Self::Replacement { hint, .. } => return hint.clone(),
+            _ => return None,
+        };
+        Some(h.to_owned())
+    }
+}
+
+/// `message; hint: hint`, the text of an error that is shown whole.
+fn message_and_hint(
+    f: &mut std::fmt::Formatter<'_>,
+    message: &str,
+    hint: Option<String>,
+) -> std::fmt::Result {
+    f.write_str(message)?;
+    match hint {
+        Some(h) => write!(f, "; hint: {h}"),
+        None => Ok(()),
+    }
+}
+
+impl std::fmt::Display for GraphError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        message_and_hint(f, &self.message(), self.hint())
+    }
+}
+
+/// Causality assignment or equation ordering failed. `Display` writes `message; hint: hint`
+/// ([`message`](Self::message), [`hint`](Self::hint)).
 #[derive(Clone, Debug, Error, PartialEq)]
 #[non_exhaustive]
 pub enum CausalityError {
     /// A storage element would be in derivative causality.
-    #[error("derivative causality: {element} ({kind}) would be in derivative causality on bond {bond}; {chain}; hint: {hint}")]
     Derivative {
         /// The storage element.
         element: String,
@@ -230,7 +317,6 @@ pub enum CausalityError {
         hint: String,
     },
     /// Two elements impose the same variable.
-    #[error("causal conflict at {element} ({kind}) on bond {bond}; {chain}; hint: {hint}")]
     Conflict {
         /// Element where the conflict shows.
         element: String,
@@ -244,7 +330,6 @@ pub enum CausalityError {
         hint: String,
     },
     /// The equations contain an algebraic loop.
-    #[error("algebraic loop through elements [{}] and bonds [{}]; hint: {hint}", elements.join(", "), bonds.join(", "))]
     AlgebraicLoop {
         /// Elements in the loop.
         elements: Vec<String>,
@@ -255,23 +340,81 @@ pub enum CausalityError {
     },
 }
 
-/// A simulation stopped early or could not start.
+impl CausalityError {
+    /// What is wrong, without the hint.
+    #[must_use]
+    pub fn message(&self) -> String {
+        match self {
+            Self::Derivative {
+                element,
+                kind,
+                bond,
+                chain,
+                ..
+            } => format!(
+                "derivative causality: {element} ({kind}) would be in derivative causality on bond {bond}; {chain}"
+            ),
+            Self::Conflict {
+                element,
+                kind,
+                bond,
+                chain,
+                ..
+            } => format!("causal conflict at {element} ({kind}) on bond {bond}; {chain}"),
+            Self::AlgebraicLoop {
+                elements, bonds, ..
+            } => format!(
+                "algebraic loop through elements [{}] and bonds [{}]",
+                elements.join(", "),
+                bonds.join(", ")
+            ),
+        }
+    }
+
+    /// What to do about it.
+    #[must_use]
+    pub fn hint(&self) -> Option<String> {
+        match self {
+            Self::Derivative { hint, .. }
+            | Self::Conflict { hint, .. }
+            | Self::AlgebraicLoop { hint, .. } => Some(hint.clone()),
+        }
+    }
+}
+
+impl std::fmt::Display for CausalityError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        message_and_hint(f, &self.message(), self.hint())
+    }
+}
+
+/// A simulation stopped early or could not start. `Display` writes `message; hint: hint`
+/// ([`message`](Self::message), [`hint`](Self::hint)).
 #[derive(Clone, Debug, Error, PartialEq)]
 #[non_exhaustive]
 pub enum SimulationError {
-    /// Settings are invalid.
-    #[error("invalid simulation settings: {0}")]
-    Settings(String),
+    /// The initial state does not have one value per state.
+    InitialState {
+        /// Values given.
+        given: usize,
+        /// States of the model.
+        expected: usize,
+    },
+    /// The solver could not be set up for a segment between events.
+    SolverSetup {
+        /// The solver's message.
+        message: String,
+    },
     /// One setting is invalid.
-    #[error("invalid simulation setting `{setting}`: {message}")]
     InvalidSetting {
         /// The setting (`t_end`, `dt_out`, `rtol`, `atol`).
         setting: &'static str,
         /// What is wrong.
         message: String,
+        /// What to do, if more than the message says.
+        hint: Option<&'static str>,
     },
     /// The solver failed.
-    #[error("solver failed at t = {t:.9} s: {message}{culprit}")]
     Solver {
         /// Time reached.
         t: f64,
@@ -279,9 +422,10 @@ pub enum SimulationError {
         message: String,
         /// Where a non-finite value first appeared, if one did.
         culprit: String,
+        /// What to do, where it is known.
+        hint: Option<&'static str>,
     },
     /// A state became NaN or infinite.
-    #[error("state `{state}` of element `{element}` became {value} at t = {t:.9} s{culprit}; hint: check parameters of `{element}` and the elements feeding it, or tighten tolerances")]
     NonFinite {
         /// Time.
         t: f64,
@@ -295,7 +439,6 @@ pub enum SimulationError {
         culprit: String,
     },
     /// A state reached a bound its element set ([`Limit`](crate::element::Limit)).
-    #[error("state `{state}` of element `{element}` reached its {which} limit {limit} at t = {t:.9} s: {message}")]
     LimitReached {
         /// Time of the crossing.
         t: f64,
@@ -309,16 +452,16 @@ pub enum SimulationError {
         limit: f64,
         /// The element's explanation.
         message: String,
+        /// The element's advice ([`Limit::hint`](crate::element::Limit::hint)).
+        hint: Option<String>,
     },
     /// The run was interrupted ([`Settings::interrupt`](crate::Settings::interrupt): SIGINT,
     /// SIGTERM) after the step that reached `t`.
-    #[error("interrupted at t = {t:.9} s")]
     Interrupted {
         /// Time reached.
         t: f64,
     },
     /// The sink of the output rows refused one (a full disk, a closed file).
-    #[error("the output row at t = {t:.9} s could not be written: {message}")]
     Output {
         /// Time of the refused row.
         t: f64,
@@ -326,13 +469,81 @@ pub enum SimulationError {
         message: String,
     },
     /// A scheduled event could not be applied.
-    #[error("event at t = {t} s: {source}")]
     Event {
         /// Event time.
         t: f64,
         /// Why.
         source: GraphError,
     },
+}
+
+impl SimulationError {
+    /// What is wrong, without the hint.
+    #[must_use]
+    pub fn message(&self) -> String {
+        match self {
+            Self::InitialState { given, expected } => format!(
+                "invalid simulation settings: initial state has {given} values, the model {expected} states"
+            ),
+            Self::SolverSetup { message } => format!("invalid simulation settings: {message}"),
+            Self::InvalidSetting {
+                setting, message, ..
+            } => format!("invalid simulation setting `{setting}`: {message}"),
+            Self::Solver {
+                t,
+                message,
+                culprit,
+                ..
+            } => format!("solver failed at t = {t:.9} s: {message}{culprit}"),
+            Self::NonFinite {
+                t,
+                state,
+                element,
+                value,
+                culprit,
+            } => format!(
+                "state `{state}` of element `{element}` became {value} at t = {t:.9} s{culprit}"
+            ),
+            Self::LimitReached {
+                t,
+                state,
+                element,
+                which,
+                limit,
+                message,
+                ..
+            } => format!(
+                "state `{state}` of element `{element}` reached its {which} limit {limit} at t = {t:.9} s: {message}"
+            ),
+            Self::Interrupted { t } => format!("interrupted at t = {t:.9} s"),
+            Self::Output { t, message } => {
+                format!("the output row at t = {t:.9} s could not be written: {message}")
+            }
+            Self::Event { t, source } => format!("event at t = {t} s: {}", source.message()),
+        }
+    }
+
+    /// What to do about it, where it is known.
+    #[must_use]
+    pub fn hint(&self) -> Option<String> {
+        match self {
+            Self::InvalidSetting { hint, .. } | Self::Solver { hint, .. } => {
+                hint.map(str::to_owned)
+            }
+            Self::NonFinite { element, .. } => Some(format!(
+                "check parameters of `{element}` and the elements feeding it, or tighten tolerances"
+            )),
+            Self::LimitReached { hint, .. } => hint.clone(),
+            Self::Event { source, .. } => source.hint(),
+            _ => None,
+        }
+    }
+}
+
+impl std::fmt::Display for SimulationError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        message_and_hint(f, &self.message(), self.hint())
+    }
 }
 
 /// Any error of this crate.
@@ -351,4 +562,28 @@ pub enum Error {
     /// See [`SimulationError`].
     #[error(transparent)]
     Simulation(#[from] SimulationError),
+}
+
+impl Error {
+    /// What is wrong, without the hint.
+    #[must_use]
+    pub fn message(&self) -> String {
+        match self {
+            Self::Param(e) => e.to_string(),
+            Self::Graph(e) => e.message(),
+            Self::Causality(e) => e.message(),
+            Self::Simulation(e) => e.message(),
+        }
+    }
+
+    /// What to do about it, where the core knows.
+    #[must_use]
+    pub fn hint(&self) -> Option<String> {
+        match self {
+            Self::Param(_) => None,
+            Self::Graph(e) => e.hint(),
+            Self::Causality(e) => e.hint(),
+            Self::Simulation(e) => e.hint(),
+        }
+    }
 }

@@ -400,6 +400,7 @@ pub(crate) fn check_same_shape(
         Err(GraphError::Replacement {
             element: name.to_owned(),
             message,
+            hint: None,
         })
     };
     if old.kind() != new.kind() {

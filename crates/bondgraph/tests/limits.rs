@@ -34,6 +34,7 @@ impl Element for Ramp {
             lower: self.lower,
             upper: self.upper,
             message: "the ramp ran out".into(),
+            hint: None,
         }]
     }
 }

@@ -173,8 +173,11 @@ impl Element for Piston {
             lower: 0.0,
             upper: self.s_max,
             message: format!(
-                "the piston left its stroke [0, {}] m and the cylinder has no end stop; hint: add an end stop (k_stop, c_stop) or keep the set-point inside the stroke",
+                "the piston left its stroke [0, {}] m and the cylinder has no end stop",
                 self.s_max
+            ),
+            hint: Some(
+                "add an end stop (k_stop, c_stop) or keep the set-point inside the stroke".into(),
             ),
         }]
     }

@@ -107,6 +107,14 @@ impl ModelError {
         self.hint = Some(clip_to(&hint.into(), MAX_MESSAGE));
         self
     }
+    /// With `hint` if there is one, else as it is.
+    #[must_use]
+    pub(crate) fn or_hint(self, hint: Option<String>) -> Self {
+        match hint {
+            Some(h) => self.hint(h),
+            None => self,
+        }
+    }
     /// With the error underneath.
     #[must_use]
     pub fn with_source(mut self, source: impl std::error::Error + Send + Sync + 'static) -> Self {
@@ -133,6 +141,51 @@ impl fmt::Display for ModelError {
             write!(f, "\n  hint: {h}")?;
         }
         Ok(())
+    }
+}
+
+impl ErrorKind {
+    /// The kind's name in JSON (`bad_parameter`, `unknown_kind`, …).
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Io => "io",
+            Self::Syntax => "syntax",
+            Self::Override => "override",
+            Self::UnknownKind => "unknown_kind",
+            Self::UnknownElement => "unknown_element",
+            Self::MissingParameter => "missing_parameter",
+            Self::ExtraParameter => "extra_parameter",
+            Self::BadParameter => "bad_parameter",
+            Self::Graph => "graph",
+            Self::Causality => "causality",
+            Self::Settings => "settings",
+            Self::Scene => "scene",
+            Self::Plot => "plot",
+        }
+    }
+}
+
+impl serde::Serialize for ErrorKind {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+/// As JSON: `{"file", "line", "column", "element", "kind", "message", "hint"}` (`null`
+/// where there is none); the source is not written (its message is the message).
+impl serde::Serialize for ModelError {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let mut m = s.serialize_struct("ModelError", 7)?;
+        m.serialize_field("file", &self.file)?;
+        m.serialize_field("line", &self.line)?;
+        m.serialize_field("column", &self.col)?;
+        m.serialize_field("element", &self.element)?;
+        m.serialize_field("kind", &self.kind)?;
+        m.serialize_field("message", &self.message)?;
+        m.serialize_field("hint", &self.hint)?;
+        m.end()
     }
 }
 

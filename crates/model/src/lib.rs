@@ -22,26 +22,32 @@
 //!
 //! `docs/model-format.md` documents the format.
 //!
-//! ## Loading
-//! [`Model::load`] parses, applies `--set` overrides ([`overrides::apply`]), builds every
-//! element through the [`Registry`], assigns causality and assembles the equations. Every
-//! failure is a [`ModelError`] with file, line, column, element and hint.
-//! [`inspect`] goes as far as it can and reports what it found (`bg-sim check`);
-//! [`structure`] stops at the bond graph and its causality, for drawing (`bg-sim graph`).
+//! ## Contents
+//! Loading, a stage per module of [`load`]:
+//! 1. parse: the file (after `--set`, [`overrides`]) as TOML with spans into typed sections;
+//! 2. resolve: `[parameters]` and their expressions ([`expr`]);
+//! 3. build: each entry through its kind's declaration ([`Registry`], [`reader`]'s
+//!    [`ElementSpec`]) into elements, composites expanded;
+//! 4. wire: bonds into the graph, signals, causality; then the equations;
+//! 5. the model: initial values (a steady start, [`steady`]), settings ([`solver`]),
+//!    outputs, checks, events ([`Model`]).
 //!
-//! ## Scene switches
-//! `[scene]` declares the switches between richer and cheaper scenes (modes, lumped masses,
-//! …), each a `--set` key with its choices; [`Model::scene`] exposes them ([`scene`]).
+//! [`Model::load`] reports the first problem, [`inspect`] every one (`bg-sim check`),
+//! [`structure`] stops at the graph and its causality (`bg-sim graph`). Every problem is a
+//! [`ModelError`] ([`error`]): file, line, column, element, message, hint, source.
+//!
+//! Around a model: [`scene`] (switches between richer and cheaper scenes), [`plots`]
+//! (`[[plot]]` tables), [`describe`] (a kind's parameters, for `bg-sim kinds`).
 //!
 //! ## Element kinds
 //! [`Registry::with_core`] knows the core kinds ([`bondgraph::kinds`]); domain crates hand
 //! over theirs with [`Registry::add`]. Each kind is a [`bondgraph::KindDecl`]: parameters
-//! declared as data, read for its builder by an [`ElementSpec`] ([`reader`]), which turns
-//! every problem into a [`ModelError`] at the parameter's line.
+//! declared as data, read for its builder by an [`ElementSpec`], which turns every problem
+//! into a [`ModelError`] at the parameter's line.
 //!
 //! ## Expressions
-//! Parameters and element values may be expressions ([`expr`]): `"pi/4*d^2"`, `"1/k"`, or,
-//! where an element allows modulation, functions of signals and time: `"1 + 0.1*spring.q"`.
+//! Parameters and element values may be expressions: `"pi/4*d^2"`, `"1/k"`, or, where an
+//! element allows modulation, functions of signals and time: `"1 + 0.1*spring.q"`.
 
 pub mod describe;
 pub mod error;
@@ -56,7 +62,10 @@ pub mod steady;
 
 pub use describe::{describe, parameter_table, KindReport};
 pub use error::{ErrorKind, ModelError};
-pub use load::{inspect, structure, Check, CheckResult, Entry, Inspection, Model, Structure};
+pub use load::{
+    inspect, solver, structure, Check, CheckResult, Entry, Inspection, Model, Structure,
+    UnknownSolver,
+};
 pub use plots::{Panel, Plot, Series};
 pub use reader::{ElementSpec, RawValue};
 pub use registry::Registry;

@@ -124,13 +124,10 @@ fn bench(a: &BenchArgs<'_>) -> ExitCode {
     }
     let mut methods = Vec::new();
     for s in a.solvers {
-        match Method::parse(s) {
-            Some(m) => methods.push(m),
-            None => {
-                tell!(
-                    "error: unknown solver `{s}`\n  hint: solvers are {}",
-                    Method::names()
-                );
+        match bg_model::solver(s) {
+            Ok(m) => methods.push(m),
+            Err(e) => {
+                tell!("error: {e}\n  hint: {}", e.hint());
                 return ExitCode::from(2);
             }
         }

@@ -4,7 +4,6 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use bondgraph::Method;
 
 use super::{parse_floors, BAD_INPUT};
 
@@ -79,14 +78,10 @@ pub fn command(a: Args) -> ExitCode {
         tell!("error: unknown search `{search}`\n  hint: auto, grid or greedy");
         return ExitCode::from(BAD_INPUT);
     };
-    let method = match solver.as_deref().map(|s| (s, Method::parse(s))) {
-        None => None,
-        Some((_, Some(m))) => Some(m),
-        Some((s, None)) => {
-            tell!(
-                "error: unknown solver `{s}`\n  hint: solvers are {}",
-                Method::names()
-            );
+    let method = match solver.as_deref().map(bg_model::solver).transpose() {
+        Ok(m) => m,
+        Err(e) => {
+            tell!("error: {e}\n  hint: {}", e.hint());
             return ExitCode::from(BAD_INPUT);
         }
     };

@@ -8,7 +8,7 @@ use std::process::ExitCode;
 
 use bg_model::{CheckResult, Model, ModelError};
 use bg_sim::registry;
-use bondgraph::{Method, SimulationError, Statistics};
+use bondgraph::{SimulationError, Statistics};
 use serde_json::json;
 
 use super::json::{problems, Format};
@@ -134,17 +134,9 @@ fn run(
         }
     };
     if let Some(s) = solver {
-        match Method::parse(s) {
-            Some(m) => model.settings.method = m,
-            None => {
-                return refuse(
-                    facts,
-                    format!(
-                        "unknown solver `{s}`\n  hint: solvers are {}",
-                        Method::names()
-                    ),
-                )
-            }
+        match bg_model::solver(s) {
+            Ok(m) => model.settings.method = m,
+            Err(e) => return refuse(facts, format!("{e}\n  hint: {}", e.hint())),
         }
     }
     if let Some(v) = rtol {

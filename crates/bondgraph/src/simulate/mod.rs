@@ -154,8 +154,13 @@ fn time_resolution(s: &Settings) -> f64 {
 impl Settings {
     /// Check the settings make sense.
     pub fn validate(&self) -> Result<(), SimulationError> {
-        let bad =
-            |setting, message: String| Err(SimulationError::InvalidSetting { setting, message });
+        let bad = |setting, message: String| {
+            Err(SimulationError::InvalidSetting {
+                setting,
+                message,
+                hint: None,
+            })
+        };
         if !self.t_start.is_finite() || !self.t_end.is_finite() || self.t_end <= self.t_start {
             return bad(
                 "t_end",
@@ -173,16 +178,17 @@ impl Settings {
         }
         let res = time_resolution(self);
         if self.t_end - self.t_start < 1e4 * res {
-            return bad(
-                "t_end",
-                format!(
-                    "t_end − t_start = {:e} s is too short to integrate at times near {:e} s, where f64 times are {:e} s apart and the shortest step is {res:e} s; it must be at least {:e} s (hint: start the time at 0)",
+            return Err(SimulationError::InvalidSetting {
+                setting: "t_end",
+                message: format!(
+                    "t_end − t_start = {:e} s is too short to integrate at times near {:e} s, where f64 times are {:e} s apart and the shortest step is {res:e} s; it must be at least {:e} s",
                     self.t_end - self.t_start,
                     self.t_start.abs().max(self.t_end.abs()),
                     f64::EPSILON * self.t_start.abs().max(self.t_end.abs()),
                     1e4 * res
                 ),
-            );
+                hint: Some("start the time at 0"),
+            });
         }
         if self.dt_out < res {
             return bad(
@@ -340,6 +346,7 @@ struct Bound {
     element: String,
     state: String,
     message: String,
+    hint: Option<String>,
 }
 
 impl Bound {
@@ -359,6 +366,7 @@ impl Bound {
             which: if self.upper { "upper" } else { "lower" },
             limit: self.value,
             message: self.message.clone(),
+            hint: self.hint.clone(),
         }
     }
 }
@@ -381,6 +389,7 @@ fn bounds(eqs: &StateEquations) -> Vec<Bound> {
                         element: node.name.clone(),
                         state: info.name.clone(),
                         message: l.message.clone(),
+                        hint: l.hint.clone(),
                     });
                 }
             }
@@ -623,9 +632,12 @@ pub fn check_in_memory(settings: &Settings, columns: usize) -> Result<(), Simula
         return Err(SimulationError::InvalidSetting {
             setting: "dt_out",
             message: format!(
-                "{} gives {:.3e} rows × {columns} columns = {values:.3e} values, more than the {MAX_VALUES_IN_MEMORY:e} a run kept in memory may hold (hint: stream the rows to a file: `bg-sim run` does, `simulate_into` in a program)",
+                "{} gives {:.3e} rows × {columns} columns = {values:.3e} values, more than the {MAX_VALUES_IN_MEMORY:e} a run kept in memory may hold",
                 settings.dt_out,
                 settings.output_rows()
+            ),
+            hint: Some(
+                "stream the rows to a file: `bg-sim run` does, `simulate_into` in a program",
             ),
         });
     }
@@ -692,11 +704,10 @@ pub fn simulate_into(
         return out;
     }
     if x0.len() != eqs.n_states() {
-        out.error = Some(SimulationError::Settings(format!(
-            "initial state has {} values, the model {} states",
-            x0.len(),
-            eqs.n_states()
-        )));
+        out.error = Some(SimulationError::InitialState {
+            given: x0.len(),
+            expected: eqs.n_states(),
+        });
         return out;
     }
     if let Some((i, v)) = x0.iter().enumerate().find(|(_, v)| !v.is_finite()) {

@@ -167,6 +167,7 @@ pub(super) fn run_radau(
                     t,
                     message: e.to_string(),
                     culprit,
+                    hint: None,
                 },
             ));
         }

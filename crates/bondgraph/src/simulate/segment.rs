@@ -80,6 +80,7 @@ pub(super) fn run_segment(
                     t,
                     message: "the equations are not finite at the start".into(),
                     culprit: c,
+                    hint: None,
                 },
             ));
         }
@@ -108,7 +109,15 @@ pub(super) fn run_segment(
         .build();
     let mut problem = match problem {
         Ok(p) => p,
-        Err(e) => return Err((t, x.to_vec(), SimulationError::Settings(format!("{e}")))),
+        Err(e) => {
+            return Err((
+                t,
+                x.to_vec(),
+                SimulationError::SolverSetup {
+                    message: format!("{e}"),
+                },
+            ))
+        }
     };
     // diffsol counts Newton failures cumulatively over a solver's life: recovered failures
     // must not end a long segment, but a NaN step size never trips the step-size check, so
@@ -157,6 +166,7 @@ pub(super) fn run_segment(
                 t,
                 message,
                 culprit: String::new(),
+                hint: None,
             },
         )),
     }

@@ -121,6 +121,7 @@ pub(super) fn drive(
         t,
         message,
         culprit,
+        hint: None,
     };
     loop {
         let step = s.step();
@@ -137,12 +138,25 @@ pub(super) fn drive(
         let too_many = s.work().steps + stats.steps >= max_steps;
         if stalled || too_many {
             finish(s, stats);
-            let message = if stalled {
-                format!("the step size collapsed to {h:e}")
+            let (message, hint) = if stalled {
+                (format!("the step size collapsed to {h:e}"), None)
             } else {
-                format!("more than {max_steps} steps; hint: the model may be much stiffer than the method (try radau5 or bdf) or max_steps too small")
+                (
+                    format!("more than {max_steps} steps"),
+                    Some("the model may be much stiffer than the method (try radau5 or bdf) or max_steps too small"),
+                )
             };
-            return Err((t, x, solver_error(t, message, culprit(eqs, bad))));
+            let culprit = culprit(eqs, bad);
+            return Err((
+                t,
+                x,
+                SimulationError::Solver {
+                    t,
+                    message,
+                    culprit,
+                    hint,
+                },
+            ));
         }
         // The run observes an interruption (`Settings::interrupt`) and a refused row here, in
         // one place, after every accepted step; the per-step outputs (checks) are handed on too.

@@ -5,7 +5,8 @@ use std::path::Path;
 
 use bondgraph::{assign_causality, BondGraph, ElementId};
 
-use super::{build_graph, core_error, parse, read_model};
+use super::parse::{parse, read_model};
+use super::wire::{build_graph, core_error};
 use crate::error::ModelError;
 use crate::registry::Registry;
 
@@ -47,11 +48,12 @@ pub fn structure(
     let file = path.display().to_string();
     let text = read_model(path, &file)?;
     let mut p = parse(&file, &text, registry, overrides)?;
-    let g = build_graph(&mut p)?;
+    let g = build_graph(&mut p);
+    p.first_problem()?;
     let (graph, causality) = match assign_causality(g) {
         Ok(cg) => (cg.graph, Ok(cg.effort_setter)),
         // the graph went into the failed assignment: build it once more
-        Err(e) => (build_graph(&mut p)?, Err(core_error(&p.source, e))),
+        Err(e) => (build_graph(&mut p), Err(core_error(&p.source, e))),
     };
     let entries = p
         .source

@@ -1,0 +1,80 @@
+//! What the loader keeps of a model file once parsed: its text (to place errors), its
+//! entries with their raw parameters (to rebuild an element for an event) and its events.
+
+use std::collections::HashSet;
+use std::ops::Range;
+
+use indexmap::IndexMap;
+
+use crate::error::{line_col, ErrorKind, ModelError};
+use crate::reader::RawValue;
+use crate::registry::Registry;
+
+/// One `[elements]` entry as written.
+#[derive(Clone, Debug)]
+pub(super) struct ElementDef {
+    pub(super) name: String,
+    pub(super) kind: String,
+    pub(super) params: IndexMap<String, RawValue>,
+    pub(super) name_span: Range<usize>,
+    /// The `[parameters]` its values use (filled when it is built).
+    pub(super) used: HashSet<String>,
+    /// Global names of the elements this entry became (itself, or a composite's members).
+    pub(super) members: Vec<String>,
+    /// A composite's exposed ports: name → `member` or `member.port` (global names).
+    pub(super) ports: Vec<(String, String)>,
+}
+
+/// One `[[events]]` table as written.
+#[derive(Clone, Debug)]
+pub(super) struct EventDef {
+    pub(super) t: f64,
+    pub(super) set: IndexMap<String, RawValue>,
+    pub(super) span: Range<usize>,
+}
+
+/// The model file as the later stages and the events need it.
+#[derive(Clone, Debug)]
+pub(super) struct Source {
+    pub(super) file: String,
+    pub(super) text: String,
+    pub(super) registry: Registry,
+    pub(super) param_exprs: IndexMap<String, RawValue>,
+    pub(super) elements: Vec<ElementDef>,
+    pub(super) events: Vec<EventDef>,
+    /// Lines (1-based) that `--set` wrote or changed: errors there say so.
+    pub(super) changed_lines: Vec<usize>,
+    /// The `[[plot]]` tables (`crate::plots`).
+    pub(super) plots: Vec<crate::plots::Plot>,
+}
+
+impl Source {
+    /// An error at `span` of the file.
+    pub(super) fn err(
+        &self,
+        kind: ErrorKind,
+        span: Option<&Range<usize>>,
+        message: impl Into<String>,
+    ) -> ModelError {
+        let pos = span.map(|s| line_col(&self.text, s.start));
+        let e = ModelError::new(kind, &self.file, message).at(pos);
+        mark_set_line(e, &self.changed_lines)
+    }
+
+    /// Line and column of the entry that defines element `name` (or a member of it).
+    pub(super) fn element_pos(&self, name: &str) -> Option<(usize, usize)> {
+        self.elements
+            .iter()
+            .find(|e| e.name == name || e.members.iter().any(|m| m == name))
+            .map(|e| line_col(&self.text, e.name_span.start))
+    }
+}
+
+/// Say so when an error points at a line that `--set` wrote or changed.
+pub(super) fn mark_set_line(mut e: ModelError, changed: &[usize]) -> ModelError {
+    if e.line.is_some_and(|l| changed.contains(&l)) {
+        e.message
+            .push_str(" (at a line written by --set: the file as changed by the overrides)");
+    }
+    e
+}
