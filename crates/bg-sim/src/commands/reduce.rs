@@ -4,7 +4,6 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-
 use super::{parse_floors, BAD_INPUT};
 
 /// The options of `bg-sim reduce` (its summary is on `Command::Reduce` in main.rs).
