@@ -294,7 +294,10 @@ impl<'a> ElementSpec<'a> {
                     d.name, d.range
                 ),
             )
-            .hint(format!("`{}` is the {}", d.name, d.doc)))
+            .hint(format!(
+                "fix `{}` of `{}`: it is the {}",
+                d.name, self.name, d.doc
+            )))
     }
 
     fn raw(&self, key: &str) -> Option<&toml::Value> {

@@ -43,11 +43,18 @@ impl Source {
     fn unknown_kind(&self, def: &ElementDef) -> ModelError {
         let mut kinds: Vec<&str> = self.registry.kinds().map(|k| k.name).collect();
         kinds.sort_unstable();
-        let close: Vec<&str> = kinds
+        let mut close: Vec<&str> = kinds
             .iter()
             .copied()
             .filter(|k| k.eq_ignore_ascii_case(&def.kind) || k.ends_with(&format!(".{}", def.kind)))
             .collect();
+        if close.is_empty() {
+            close = kinds
+                .iter()
+                .copied()
+                .filter(|k| bondgraph::kind::similar(&def.kind, k))
+                .collect();
+        }
         let hint = if close.is_empty() {
             format!("known kinds: {}", kinds.join(", "))
         } else {
