@@ -26,6 +26,7 @@
 //! `time_of_max`, `time_of_min`, `first_crossing` (linear interpolation between output rows;
 //! empty if never crossed). `mean` and `rms` are over the output rows (uniform `dt_out`).
 
+mod csv;
 mod design;
 mod run;
 mod spec;
@@ -47,7 +48,7 @@ pub use run::{run_point, RunRow, Status};
 pub use spec::{parse_metric, parse_spec, Design, Metric, Reduction, Spec, Value, Values};
 pub use summary::{header, line, read_summary};
 
-use summary::csv_split;
+use csv::csv_split;
 
 /// Name of the summary table in the output folder.
 pub const SUMMARY: &str = "summary.csv";

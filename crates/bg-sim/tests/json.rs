@@ -115,3 +115,55 @@ fn run_json_on_a_bad_model_is_refused_with_its_problems() {
     assert!(v["statistics"].is_null());
     assert_eq!(v["problems"][0]["line"], 13, "{v:#}");
 }
+
+#[test]
+fn check_json_lists_every_problem_of_a_file_with_two_independent_mistakes() {
+    // a misspelt parameter in one element and an out-of-range value in another
+    let text = std::fs::read_to_string(model("mass_spring_damper")).unwrap();
+    let text = text
+        .replacen("kind = \"R\", r = ", "kind = \"R\", rr = ", 1)
+        .replacen("kind = \"I\", m = \"m\"", "kind = \"I\", m = -2.0", 1);
+    let dir = std::env::temp_dir().join(format!("bg-sim-json-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("two_mistakes.toml");
+    std::fs::write(&path, &text).unwrap();
+    let (code, v) = json(&[
+        "check".as_ref(),
+        path.as_os_str(),
+        "--format".as_ref(),
+        "json".as_ref(),
+    ]);
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(code, 1, "{v:#}");
+    let problems = v["problems"].as_array().unwrap();
+    assert_eq!(problems.len(), 2, "{v:#}");
+    let by_element = |e: &str| {
+        problems
+            .iter()
+            .find(|p| p["element"] == e)
+            .unwrap_or_else(|| panic!("no problem for `{e}`: {v:#}"))
+    };
+    let (damper, mass) = (by_element("damper"), by_element("mass"));
+    assert_eq!(damper["kind"], "extra_parameter", "{damper:#}");
+    assert!(
+        damper["message"].as_str().unwrap().contains("`rr`"),
+        "{damper:#}"
+    );
+    assert!(
+        damper["hint"]
+            .as_str()
+            .unwrap()
+            .contains("did you mean `r`"),
+        "{damper:#}"
+    );
+    assert_eq!(mass["kind"], "bad_parameter", "{mass:#}");
+    assert!(
+        mass["message"].as_str().unwrap().contains("> 0"),
+        "{mass:#}"
+    );
+    for p in [damper, mass] {
+        assert!(p["line"].as_u64().is_some_and(|l| l > 1), "{p:#}");
+        assert!(p["hint"].is_string(), "{p:#}");
+    }
+    assert_ne!(damper["line"], mass["line"]);
+}

@@ -1,7 +1,7 @@
 //! The runs of a spec: a full grid or a seeded Latin-hypercube sample ([`points`]), and
 //! each run's identity ([`Point::id`]).
 
-use super::spec::{Design, Spec, Value, Values};
+use super::spec::{run_count, Design, Spec, Value, Values};
 
 /// One run of a sweep: its position and its values.
 #[derive(Clone, Debug)]
@@ -35,20 +35,6 @@ impl Point {
             .iter()
             .map(|(k, v)| format!("{k}={}", v.render()))
             .collect()
-    }
-}
-
-pub(super) fn run_count(spec: &Spec) -> usize {
-    match spec.design {
-        Design::Lhs { samples, .. } => samples,
-        Design::Grid => spec
-            .parameters
-            .iter()
-            .map(|(_, v)| match v {
-                Values::List(l) => l.len(),
-                Values::Range { n, .. } => (*n).max(1),
-            })
-            .fold(1usize, usize::saturating_mul),
     }
 }
 

@@ -11,9 +11,9 @@ use std::time::Instant;
 
 use bg_model::{Model, Registry};
 
+use super::csv::csv_field;
 use super::design::Point;
 use super::spec::{Metric, Reduction};
-use super::summary::csv_field;
 
 /// How one run ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

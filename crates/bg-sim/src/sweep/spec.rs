@@ -3,7 +3,6 @@
 
 use bg_model::expr::Expr;
 
-use super::design::run_count;
 use super::{err, SweepError, MAX_RUNS};
 
 /// A value given to one `--set` path.
@@ -370,4 +369,19 @@ pub fn parse_metric(name: &str, src: &str) -> Result<Metric, String> {
         level,
         source: src.to_owned(),
     })
+}
+
+/// How many runs `spec` asks for: its samples, or the product of its grid's lengths.
+pub(super) fn run_count(spec: &Spec) -> usize {
+    match spec.design {
+        Design::Lhs { samples, .. } => samples,
+        Design::Grid => spec
+            .parameters
+            .iter()
+            .map(|(_, v)| match v {
+                Values::List(l) => l.len(),
+                Values::Range { n, .. } => (*n).max(1),
+            })
+            .fold(1usize, usize::saturating_mul),
+    }
 }

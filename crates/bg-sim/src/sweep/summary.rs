@@ -5,40 +5,10 @@ use std::fmt::Write as _;
 use std::fs;
 use std::path::Path;
 
+use super::csv::{csv_field, csv_split};
 use super::run::RunRow;
 use super::spec::Spec;
 use super::{err, SweepError};
-
-/// RFC 4180 quoting where needed; line breaks become ` / ` so one run is one line.
-pub(super) fn csv_field(s: &str) -> String {
-    let s = s.replace("\r\n", " / ").replace(['\n', '\r'], " / ");
-    if s.contains([',', '"']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s
-    }
-}
-
-/// Split one CSV line written by [`csv_field`] into fields.
-pub(super) fn csv_split(line: &str) -> Vec<String> {
-    let mut out = Vec::new();
-    let mut cur = String::new();
-    let mut quoted = false;
-    let mut chars = line.chars().peekable();
-    while let Some(c) = chars.next() {
-        match (c, quoted) {
-            ('"', true) if chars.peek() == Some(&'"') => {
-                cur.push('"');
-                chars.next();
-            }
-            ('"', q) => quoted = !q,
-            (',', false) => out.push(std::mem::take(&mut cur)),
-            (c, _) => cur.push(c),
-        }
-    }
-    out.push(cur);
-    out
-}
 
 /// The summary's header: run id, index, the swept paths, the metrics, then the run's facts.
 #[must_use]
@@ -79,18 +49,4 @@ pub fn read_summary(path: &Path) -> Result<(Vec<String>, Vec<Vec<String>>), Swee
         .map(csv_split)
         .ok_or_else(|| err(&shown, "empty"))?;
     Ok((head, lines.map(csv_split).collect()))
-}
-
-#[cfg(test)]
-mod tests {
-    #![allow(clippy::unwrap_used)]
-    use super::*;
-
-    #[test]
-    fn csv_fields_round_trip() {
-        let f = ["a", "b,c", "say \"hi\"", "two\nlines"];
-        let l: Vec<String> = f.iter().map(|s| csv_field(s)).collect();
-        let back = csv_split(&l.join(","));
-        assert_eq!(back, ["a", "b,c", "say \"hi\"", "two / lines"]);
-    }
 }
