@@ -166,4 +166,20 @@ fn check_json_lists_every_problem_of_a_file_with_two_independent_mistakes() {
         assert!(p["hint"].is_string(), "{p:#}");
     }
     assert_ne!(damper["line"], mass["line"]);
+    // `run --format json` refuses the same file with the same two problems
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(&path, &text).unwrap();
+    let out = dir.join("out.csv");
+    let (code, v) = json(&[
+        "run".as_ref(),
+        path.as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+        "--format".as_ref(),
+        "json".as_ref(),
+    ]);
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(code, 2, "{v:#}");
+    assert_eq!(v["outcome"], "refused", "{v:#}");
+    assert_eq!(v["problems"].as_array().unwrap().len(), 2, "{v:#}");
 }

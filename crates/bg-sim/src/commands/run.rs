@@ -129,7 +129,11 @@ fn run(
     let mut model = match Model::load(path, &registry(), set) {
         Ok(m) => m,
         Err(e) => {
+            // The text report names the first problem; the JSON lists every one the loader
+            // finds in one pass (the same list as `check`), the first one first.
+            let all = bg_model::inspect(path, &registry(), set).problems;
             facts.problems.push(e.clone());
+            facts.problems.extend(all.into_iter().filter(|p| *p != e));
             return refuse(facts, e.to_string());
         }
     };
