@@ -65,6 +65,14 @@ const VALVES: &[(&str, &[&str], &str)] = &[
         &["P", "A"],
         "q_set = X, dp_comp = 1e6, g_leak = 1e-13",
     ),
+    // the fixed restrictions obey the same two laws
+    ("hydraulics.laminar", &["a", "b"], "length = 2.0, d = 0.012"),
+    (
+        "hydraulics.orifice",
+        &["a", "b"],
+        "alpha = 1e-6, opening = \"0.5 + 0.5*sin(t)\"",
+    ),
+    ("hydraulics.leakage", &["a", "b"], "r = 1e11"),
 ];
 
 fn model(kind: &str, ports: &[&str], params: &str, p: &[f64], x: f64) -> String {
