@@ -121,7 +121,7 @@ impl LineSpec {
     /// Total laminar resistance 128 μ ℓ/(π d⁴), Pa·s/m³.
     #[must_use]
     pub fn resistance(&self) -> f64 {
-        128.0 * self.mu * self.length / (std::f64::consts::PI * self.diameter.powi(4))
+        crate::laminar::pipe_resistance(self.mu, self.length, self.diameter)
     }
 
     /// Total inertance ρ ℓ/A, kg/m⁴.

@@ -30,6 +30,7 @@
 //! [`Orifice`](crate::Orifice). Publishes each opening xᵢ (`x`, and for two openings the second
 //! one's name, e.g. `x_check`).
 
+use bondgraph::kind::{ParamDecl, Range};
 use bondgraph::{
     CausalRule, Element, Io, LocalJacobian, ParamError, PortCausality, PortSpec, Ports, SignalSpec,
     Slot, Stage, StateSpec,
@@ -63,6 +64,20 @@ impl Opening {
         ramp((drive - self.p_set) / self.band, self.eps)
     }
 }
+
+/// Half-width ε of the rounded corners of the opening ([`crate::ramp`]).
+pub const SMOOTHING: ParamDecl = ParamDecl::number(
+    "smoothing",
+    "1",
+    "half-width ε of the opening's rounded corners, fraction of its pressure band",
+)
+.range(Range::closed(0.0, 0.5))
+.default(0.05);
+/// The seat's leak (every pressure valve of this crate declares these two).
+pub const G_LEAK: ParamDecl =
+    ParamDecl::number("g_leak", "m³/(s·Pa)", "leak conductance of the closed seat")
+        .non_negative()
+        .default(1e-15);
 
 /// A pressure-operated valve (see the module documentation for the law).
 #[derive(Debug)]

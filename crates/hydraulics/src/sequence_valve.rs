@@ -15,10 +15,10 @@
 //! Causality: conductance at both ports. Dissipates Q·(P_P − P_A) ≥ 0. Publishes `x`.
 
 use crate::orifice;
-use bondgraph::kind::{KindDecl, ParamDecl, Range};
+use bondgraph::kind::{KindDecl, ParamDecl};
 use bondgraph::ParamError;
 
-use crate::pressure_valve::{Opening, PressureValve};
+use crate::pressure_valve::{Opening, PressureValve, G_LEAK, SMOOTHING};
 
 /// Parameters of a sequence valve; [`SequenceValve::build`] makes the element.
 #[derive(Clone, Debug, PartialEq)]
@@ -76,20 +76,6 @@ impl SequenceValve {
         )
     }
 }
-
-/// Half-width ε of the rounded corners of the opening ([`crate::ramp`]).
-const SMOOTHING: ParamDecl = ParamDecl::number(
-    "smoothing",
-    "1",
-    "half-width ε of the opening's rounded corners, fraction of its pressure band",
-)
-.range(Range::closed(0.0, 0.5))
-.default(0.05);
-/// The seat's leak.
-const G_LEAK: ParamDecl =
-    ParamDecl::number("g_leak", "m³/(s·Pa)", "leak conductance of the closed seat")
-        .non_negative()
-        .default(1e-15);
 
 /// Kind `hydraulics.sequence_valve`.
 pub const KIND: KindDecl = KindDecl::element(

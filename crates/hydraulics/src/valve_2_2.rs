@@ -38,6 +38,24 @@ pub struct Valve22 {
     p_tr: f64,
 }
 
+/// The opening of a switching valve's edge and its slope do/du at command `u`: `u` clamped
+/// to [0, 1], or `1 − u` for a normally-open edge (shared by the 2/2 and 3/2 valves).
+#[must_use]
+pub(crate) fn command_opening(u: f64, normally_open: bool) -> (f64, f64) {
+    let (o, d) = if u < 0.0 {
+        (0.0, 0.0)
+    } else if u > 1.0 {
+        (1.0, 0.0)
+    } else {
+        (u, 1.0)
+    };
+    if normally_open {
+        (1.0 - o, -d)
+    } else {
+        (o, d)
+    }
+}
+
 impl Valve22 {
     /// A 2/2 valve; see the struct documentation for the parameters.
     pub fn new(
@@ -63,20 +81,9 @@ impl Valve22 {
         })
     }
 
-    /// The opening and its slope do/du at command `u`.
+    /// The opening and its slope do/du at command `u` ([`command_opening`]).
     fn opening(&self, u: f64) -> (f64, f64) {
-        let (o, d) = if u < 0.0 {
-            (0.0, 0.0)
-        } else if u > 1.0 {
-            (1.0, 0.0)
-        } else {
-            (u, 1.0)
-        };
-        if self.normally_open {
-            (1.0 - o, -d)
-        } else {
-            (o, d)
-        }
+        command_opening(u, self.normally_open)
     }
 
     /// Flow from P to A at command `u` and pressures `p_p`, `p_a`.

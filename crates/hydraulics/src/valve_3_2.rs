@@ -67,18 +67,7 @@ impl Valve32 {
 
     /// The P→A opening and its slope do/du at command `u`.
     fn opening(&self, u: f64) -> (f64, f64) {
-        let (o, d) = if u < 0.0 {
-            (0.0, 0.0)
-        } else if u > 1.0 {
-            (1.0, 0.0)
-        } else {
-            (u, 1.0)
-        };
-        if self.normally_open {
-            (1.0 - o, -d)
-        } else {
-            (o, d)
-        }
+        crate::valve_2_2::command_opening(u, self.normally_open)
     }
 
     /// The edge flows `(Q_PA, Q_AT)` at command `u` and pressures P, A, T.

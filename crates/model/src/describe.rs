@@ -5,7 +5,7 @@ use std::cell::RefCell;
 use std::collections::HashSet;
 use std::fmt::Write as _;
 
-use bondgraph::kind::{Build, Default, KindDecl, ParamDecl, ParamType};
+use bondgraph::kind::{Build, KindDecl, ParamDecl, ParamType};
 use bondgraph::{Element, Ports};
 use indexmap::IndexMap;
 
@@ -130,15 +130,6 @@ pub fn describe(registry: &Registry, kind: &str) -> Result<KindReport, ModelErro
     })
 }
 
-/// A parameter's default as the tables write it.
-#[must_use]
-pub fn default_text(d: &ParamDecl) -> String {
-    match d.default {
-        Default::Required => "required".to_owned(),
-        other => other.to_string(),
-    }
-}
-
 /// The parameter table of a kind, in Markdown: `| parameter | unit | default | range | meaning |`.
 /// Nested tables follow, one per table parameter.
 #[must_use]
@@ -167,10 +158,7 @@ fn table_of(out: &mut String, prefix: &str, params: &[ParamDecl]) {
         let _ = writeln!(
             out,
             "| `{prefix}{}` | {} | {} | {range} | {} |",
-            d.name,
-            d.unit,
-            default_text(d),
-            d.doc
+            d.name, d.unit, d.default, d.doc
         );
     }
     for d in params {
