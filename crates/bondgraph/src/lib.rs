@@ -76,7 +76,8 @@ pub mod kinds;
 pub mod local_jacobian;
 pub mod modes;
 pub mod partials_check;
-pub mod radau;
+/// The Radau IIA integrator, from the solver crate (`bg-solver`), re-exported.
+pub use bg_solver::radau;
 pub mod simulate;
 
 pub use bond::{Bond, BondId, ElementId, Endpoint, PortCausality};

@@ -7,7 +7,7 @@
 //! written, so a regression in the step-size or reuse logic shows up.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use bondgraph::radau::*;
+use bg_solver::radau::*;
 
 /// An ODE from two closures: f(t, y, dy) and J(t, y, jac).
 struct Sys<F, J> {

@@ -1,18 +1,18 @@
 //! Micro-benchmark of the Radau5 LU kernels: µs per factorisation (forming diag·I − J
-//! included) and per solve, real and complex, for the kernel in `src/radau/lu.rs` ("new"),
+//! included) and per solve, real and complex, for the kernel in `src/lu/` ("new"),
 //! the previous one (`old.rs`, `Complex<f64>` elements), faer 0.24's partial-pivot LU, and
 //! the complex system as a real 2n×2n one on the new real kernel ("2n").
 //!
 //! ```text
 //! cargo run --release -p bg-sim --example dump_jacobian -- models/knuckle_boom.toml /tmp/j38.txt
-//! cargo run --release -p bondgraph --example lu_bench -- /tmp/j38.txt   # crane Jacobians
-//! cargo run --release -p bondgraph --example lu_bench                   # random dense
+//! cargo run --release -p bg-solver --example lu_bench -- /tmp/j38.txt   # crane Jacobians
+//! cargo run --release -p bg-solver --example lu_bench                   # random dense
 //! ```
 //! Each case is the minimum over rounds (the machine is shared); "diff" is the largest
 //! relative difference of the solutions from the old kernel's.
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
-#[path = "../../src/radau/lu.rs"]
+#[path = "../../src/lu/mod.rs"]
 mod lu;
 mod old;
 use lu as new;

@@ -4,7 +4,8 @@
 
 use nalgebra::Complex;
 
-use super::{lu, OdeSystem, Radau5};
+use super::{OdeSystem, Radau5};
+use crate::lu;
 
 impl Radau5 {
     /// Form and factorise (γ/h)I − J and ((α + iβ)/h)I − J.
