@@ -11,7 +11,7 @@
 //!
 //! At a kink of the equations (a clamp, a valve's switch of side at x_v = 0), where the
 //! right and left differences disagree, the entry may equal either one-sided derivative.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+#![allow(clippy::float_cmp, clippy::unwrap_used, clippy::expect_used)]
 
 use bg_tests::{is_refused, model_files};
 use bondgraph::{DMatrix, StateEquations};
@@ -59,6 +59,30 @@ fn compare(name: &str, eqs: &StateEquations, t: f64, x: &[f64]) -> (f64, usize, 
     let n = x.len();
     let mut jac = DMatrix::zeros(0, 0);
     eqs.jacobian(t, x, &mut jac);
+    // The sparse path: its pattern holds every nonzero of the dense Jacobian, and its values
+    // are the dense ones, bit for bit (so it agrees with the differences as the dense does).
+    let pattern = eqs.jacobian_pattern().unwrap();
+    let mut values = vec![f64::NAN; pattern.nnz()];
+    eqs.jacobian_sparse(t, x, &pattern, &mut values);
+    for j in 0..n {
+        for i in 0..n {
+            match pattern.slot(i, j) {
+                Some(k) => assert!(
+                    values[k] == jac[(i, j)],
+                    "{name} at t = {t}: sparse J[{i}][{j}] = {:e}, dense {:e}",
+                    values[k],
+                    jac[(i, j)]
+                ),
+                None => assert!(
+                    jac[(i, j)] == 0.0,
+                    "{name} at t = {t}: J[{i}][{j}] ({} / {}) = {:e} lies outside the sparsity pattern",
+                    eqs.states()[i].name,
+                    eqs.states()[j].name,
+                    jac[(i, j)]
+                ),
+            }
+        }
+    }
     let [jc, jr, jl] = differences(eqs, t, x);
     let nom: Vec<f64> = eqs.states().iter().map(|s| s.nominal).collect();
     let mut worst = (0.0, 0, 0);

@@ -27,7 +27,15 @@ const SECTIONS: &[&str] = &[
     "check",
     "scene",
 ];
-const SIMULATION_KEYS: &[&str] = &["t_start", "t_end", "dt_out", "solver", "rtol", "atol"];
+const SIMULATION_KEYS: &[&str] = &[
+    "t_start",
+    "t_end",
+    "dt_out",
+    "solver",
+    "rtol",
+    "atol",
+    "linear_algebra",
+];
 const EVENT_KEYS: &[&str] = &["t", "set"];
 const CHECK_KEYS: &[&str] = &["value", "expected", "tol"];
 

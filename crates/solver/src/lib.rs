@@ -9,10 +9,13 @@
 //! - [`radau`]: Radau IIA of order 5 ([`Radau5`]): one step at a time towards stop times,
 //!   dense output, restarts, its step-size control and tableau.
 //! - `lu` (private): the dense LU kernels of Radau's real and complex iteration matrices.
+//! - `sparse` (private but for [`SparsePattern`]): the sparse LU of the same matrices (faer's,
+//!   symbolic analysis once per pattern).
 
 mod lu;
 pub mod problem;
 pub mod radau;
+mod sparse;
 
-pub use problem::OdeSystem;
-pub use radau::{Radau5, RadauError, RadauOptions, RadauStats, StepReport};
+pub use problem::{OdeSystem, SparsePattern};
+pub use radau::{LinearAlgebra, Radau5, RadauError, RadauOptions, RadauStats, StepReport};

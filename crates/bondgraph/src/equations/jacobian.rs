@@ -13,7 +13,10 @@
 //! Sizes are fixed by the plan: after the first call (which allocates the workspace) a
 //! Jacobian allocates nothing.
 
+use bg_solver::SparsePattern;
 use nalgebra::DMatrix;
+
+mod sparse;
 
 use crate::element::{Element, Io, Layout, Slot, Source};
 use crate::local_jacobian::{LocalJacobian, LocalShape, Touched};
@@ -317,10 +320,16 @@ impl StateEquations {
         }
         for (id, l) in self.layouts.iter().enumerate() {
             if l.n_states > 0 {
-                block.derivatives(id, jac);
+                block.derivatives(id, &mut Out::Dense(jac));
             }
         }
     }
+}
+
+/// Where the derivative rows go.
+enum Out<'a> {
+    Dense(&'a mut DMatrix<f64>),
+    Sparse(&'a SparsePattern, &'a mut [f64]),
 }
 
 /// One Jacobian pass: the plan's values and the gradient workspace.
@@ -553,8 +562,8 @@ impl Block<'_> {
         }
     }
 
-    /// The derivative rows of element `id`, into `jac`.
-    fn derivatives(&mut self, id: usize, jac: &mut DMatrix<f64>) {
+    /// The derivative rows of element `id`, into `out`.
+    fn derivatives(&mut self, id: usize, out: &mut Out<'_>) {
         let eqs = self.eqs;
         self.eval(id, Target::Derivatives);
         let Some(plan) = eqs.jac_plan.derivatives[id].as_ref() else {
@@ -569,9 +578,25 @@ impl Block<'_> {
                 continue;
             }
             let acc = &mut w.acc[r * n + lo..r * n + hi];
-            for (j, a) in (lo..hi).zip(acc.iter_mut()) {
-                jac[(i, j)] = *a;
-                *a = 0.0;
+            match out {
+                Out::Dense(jac) => {
+                    for (j, a) in (lo..hi).zip(acc.iter_mut()) {
+                        jac[(i, j)] = *a;
+                        *a = 0.0;
+                    }
+                }
+                Out::Sparse(pattern, values) => {
+                    for (j, a) in (lo..hi).zip(acc.iter_mut()) {
+                        if *a != 0.0 {
+                            // Outside the pattern only if an element's partials left it
+                            // (jacobian_pattern); the entry is then dropped.
+                            if let Some(slot) = pattern.slot(i, j) {
+                                values[slot] = *a;
+                            }
+                            *a = 0.0;
+                        }
+                    }
+                }
             }
         }
     }

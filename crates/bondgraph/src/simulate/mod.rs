@@ -112,6 +112,8 @@ pub struct Settings {
     pub atol: f64,
     /// Most accepted steps before the run is stopped (a stalled or far too stiff run).
     pub max_steps: usize,
+    /// Radau's linear algebra: dense, sparse, or chosen by size and density (`auto`).
+    pub linear_algebra: crate::radau::LinearAlgebra,
     /// Set it to `true` (a SIGINT/SIGTERM handler, another thread) to stop the run after the
     /// current step: the rows so far are kept and the outcome's error is
     /// [`SimulationError::Interrupted`].
@@ -128,6 +130,7 @@ impl Default for Settings {
             rtol: 1e-6,
             atol: 1e-8,
             max_steps: 10_000_000,
+            linear_algebra: crate::radau::LinearAlgebra::Auto,
             interrupt: None,
         }
     }

@@ -34,6 +34,22 @@ impl OdeSystem for RadauEquations<'_> {
         self.jac_calls += 1;
         self.eqs.jacobian(t, y, jac);
     }
+    fn jacobian_pattern(&self) -> Option<crate::radau::SparsePattern> {
+        self.eqs.jacobian_pattern()
+    }
+    fn jacobian_sparse(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        _fy: &[f64],
+        pattern: &crate::radau::SparsePattern,
+        values: &mut [f64],
+        _dense: &mut nalgebra::DMatrix<f64>,
+    ) {
+        // Straight into the pattern's slots (StateEquations::jacobian_sparse).
+        self.jac_calls += 1;
+        self.eqs.jacobian_sparse(t, y, pattern, values);
+    }
 }
 
 /// [`Radau5`] as a [`Stepper`]: limits are located inside each step by bisection on the
@@ -153,6 +169,7 @@ pub(super) fn run_radau(
         rtol: settings.rtol,
         atol: atol.to_vec(),
         jacobian_theta: RADAU_JACOBIAN_THETA,
+        linear_algebra: settings.linear_algebra,
         ..RadauOptions::default()
     };
     let radau = match Radau5::new(&mut sys, t, x, options) {

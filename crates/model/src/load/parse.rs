@@ -55,6 +55,7 @@ pub(super) struct SimulationSpec {
     pub(super) solver: Option<Spanned<String>>,
     pub(super) rtol: Option<Spanned<f64>>,
     pub(super) atol: Option<Spanned<f64>>,
+    pub(super) linear_algebra: Option<Spanned<String>>,
 }
 
 #[derive(Deserialize)]

@@ -77,6 +77,20 @@ pub(super) fn read(
             ),
         }
     }
+    if let Some(s) = &sim.linear_algebra {
+        match bondgraph::radau::LinearAlgebra::from_name(s.get_ref()) {
+            Some(la) => settings.linear_algebra = la,
+            None => problems.push(
+                source
+                    .err(
+                        ErrorKind::Settings,
+                        Some(&s.span()),
+                        format!("[simulation] unknown linear_algebra `{}`", s.get_ref()),
+                    )
+                    .hint("linear_algebra is \"dense\", \"sparse\" or \"auto\" (the default: sparse for large, sparse Jacobians)"),
+            ),
+        }
+    }
     if problems.len() > before {
         return settings;
     }

@@ -2,11 +2,9 @@
 //! and restarts.
 
 use super::{
-    Controller, Failure, OdeSystem, Radau5, RadauError, RadauOptions, RadauStats, StepReport,
-    Tableau, KEEP_H, MAX_SINGULAR,
+    Controller, Failure, Linear, OdeSystem, Radau5, RadauError, RadauOptions, RadauStats,
+    StepReport, Tableau, KEEP_H, MAX_SINGULAR,
 };
-use crate::lu::{ComplexLu, RealLu};
-use nalgebra::DMatrix;
 
 impl Radau5 {
     /// Set up at (t0, y0): check the options and y0, evaluate f(t0, y0) and choose the first
@@ -104,11 +102,9 @@ impl Radau5 {
             scal: buf(),
             err_v: buf(),
             err_f: buf(),
-            jac: DMatrix::zeros(n, n),
+            lin: Linear::new(sys, n, o.linear_algebra),
             jac_current: false,
             need_jac: true,
-            lu_real: RealLu::new(n),
-            lu_complex: ComplexLu::new(n),
             lu_h: None,
             faccon: 1.0,
             theta: o.jacobian_theta,
@@ -150,6 +146,11 @@ impl Radau5 {
     #[must_use]
     pub fn stats(&self) -> &RadauStats {
         &self.stats
+    }
+    /// Whether the sparse linear algebra is in use (see [`RadauOptions::linear_algebra`]).
+    #[must_use]
+    pub fn is_sparse(&self) -> bool {
+        self.lin.is_sparse()
     }
 
     /// f(t, y) at the current point, unless already known; refuses a non-finite value.
@@ -225,7 +226,7 @@ impl Radau5 {
                 });
             }
             if self.need_jac {
-                sys.jacobian(self.t, &self.y, &self.f0, &mut self.jac);
+                self.lin.jacobian(sys, self.t, &self.y, &self.f0);
                 self.stats.jacobians += 1;
                 self.jac_current = true;
                 self.need_jac = false;

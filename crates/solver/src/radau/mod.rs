@@ -101,6 +101,7 @@
 mod controller;
 mod error;
 mod integrator;
+mod linear;
 mod stages;
 mod tableau;
 
@@ -112,8 +113,9 @@ use controller::Controller;
 pub use error::RadauError;
 use tableau::Tableau;
 
-use crate::lu::{ComplexLu, RealLu};
-pub use crate::problem::OdeSystem;
+pub use crate::problem::{OdeSystem, SparsePattern};
+use linear::Linear;
+pub use linear::{LinearAlgebra, SPARSE_MAX_DENSITY, SPARSE_MIN_STATES};
 
 /// Integrator settings.
 #[derive(Clone, Debug)]
@@ -136,6 +138,8 @@ pub struct RadauOptions {
     /// crane (38 states, finite-difference Jacobians) 0.1 needed 3–7× fewer Jacobians and
     /// ran 1.3–1.7× faster than 0.001 at rtol 1e-3 to 1e-6.
     pub jacobian_theta: f64,
+    /// Dense or sparse Jacobian and LU, or chosen by size and density (the default).
+    pub linear_algebra: LinearAlgebra,
 }
 
 impl Default for RadauOptions {
@@ -148,6 +152,7 @@ impl Default for RadauOptions {
             max_newton_iterations: 7,
             newton_tol: None,
             jacobian_theta: 0.001,
+            linear_algebra: LinearAlgebra::Auto,
         }
     }
 }
@@ -238,12 +243,11 @@ pub struct Radau5 {
     err_v: Vec<f64>,
     err_f: Vec<f64>,
 
-    jac: DMatrix<f64>,
+    /// The Jacobian and the two iteration matrices, dense or sparse.
+    lin: Linear,
     /// The Jacobian was evaluated at the current (t, y).
     jac_current: bool,
     need_jac: bool,
-    lu_real: RealLu,
-    lu_complex: ComplexLu,
     /// The step size the LU factors belong to.
     lu_h: Option<f64>,
 

@@ -5,17 +5,12 @@
 use nalgebra::Complex;
 
 use super::{OdeSystem, Radau5};
-use crate::lu;
 
 impl Radau5 {
     /// Form and factorise (γ/h)I − J and ((α + iβ)/h)I − J.
-    pub(super) fn factorise(&mut self, h: f64) -> Result<(), lu::Singular> {
-        let jac = self.jac.as_slice();
-        self.lu_real.set_shifted(self.tab.gamma / h, jac);
-        self.lu_real.factor()?;
+    pub(super) fn factorise(&mut self, h: f64) -> Result<(), ()> {
         let shift = Complex::new(self.tab.alpha / h, self.tab.beta / h);
-        self.lu_complex.set_shifted(shift, jac);
-        self.lu_complex.factor()
+        self.lin.factorise(self.tab.gamma / h, shift)
     }
 
     /// Simplified Newton for the stage values of a step of size h. Returns the number of
@@ -75,8 +70,8 @@ impl Radau5 {
                 self.dw_re[i] = g(1) - (alphn * w2 - betan * w3);
                 self.dw_im[i] = g(2) - (betan * w2 + alphn * w3);
             }
-            self.lu_real.solve(&mut self.dw_real);
-            self.lu_complex.solve(&mut self.dw_re, &mut self.dw_im);
+            self.lin.solve_real(&mut self.dw_real);
+            self.lin.solve_complex(&mut self.dw_re, &mut self.dw_im);
             newt += 1;
             self.stats.newton_iterations += 1;
             let mut sum = 0.0;
@@ -136,7 +131,7 @@ impl Radau5 {
             let y1 = self.y[i] + self.z[2][i];
             self.scal[i] = self.atol[i] + self.rtol * self.y[i].abs().max(y1.abs());
         }
-        self.lu_real.solve(&mut self.err_v);
+        self.lin.solve_real(&mut self.err_v);
         let mut err = Self::norm(&self.err_v, &self.scal).max(1e-10);
         if err >= 1.0 && (self.ctrl.first() || self.reject) {
             // Second filtering: stiff components of the first estimate are unreliable.
@@ -148,7 +143,7 @@ impl Radau5 {
             for ((e, f), dz) in self.err_v.iter_mut().zip(&self.fk[0]).zip(&self.err_f) {
                 *e = f + dz;
             }
-            self.lu_real.solve(&mut self.err_v);
+            self.lin.solve_real(&mut self.err_v);
             err = Self::norm(&self.err_v, &self.scal).max(1e-10);
         }
         if err.is_finite() {
