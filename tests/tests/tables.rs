@@ -110,7 +110,7 @@ fn bad_inputs_are_errors_at_their_line() {
     let cases = [
         (
             "F = { default = 1.0, unit = \"N\" }",
-            "F = { defualt = 1.0 }",
+            "F = { defaul = 1.0 }",
             "did you mean `default`",
         ),
         (

@@ -82,18 +82,18 @@ fn bad_data_are_clean_errors_with_exit_status_2() {
     let cases: [(&str, &str, &[&str]); 6] = [
         (
             "t,F\n0,0\n1,x\n20,1\n",
-            "line 3",
+            "bad.csv:3:",
             &["not a number", "column"],
         ),
-        ("t,F\n0,0\n1,1\n1,2\n20,1\n", "line 4", &["repeats"]),
-        ("t,F\n0,0\n2,1\n1,2\n20,1\n", "line 4", &["is before"]),
-        ("t,f\n0,0\n20,1\n", "line 1", &["did you mean `F`"]),
+        ("t,F\n0,0\n1,1\n1,2\n20,1\n", "bad.csv:4:", &["repeats"]),
+        ("t,F\n0,0\n2,1\n1,2\n20,1\n", "bad.csv:4:", &["is before"]),
+        ("t,f\n0,0\n20,1\n", "bad.csv:1:", &["did you mean `F`"]),
         (
             "t,F\n0,0\n5,1\n",
-            "line 3",
+            "bad.csv:3:",
             &["before the run's end", "extrapolate"],
         ),
-        ("t,F\n1,0\n20,1\n", "line 2", &["after the run's start"]),
+        ("t,F\n1,0\n20,1\n", "bad.csv:2:", &["after the run's start"]),
     ];
     for (text, line, words) in cases {
         let data = dir.path().join("bad.csv");
