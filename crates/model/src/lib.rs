@@ -36,6 +36,10 @@
 //! [`structure`] stops at the graph and its causality (`bg-sim graph`). Every problem is a
 //! [`ModelError`] ([`error`]): file, line, column, element, message, hint, source.
 //!
+//! External inputs and data: `[inputs]` (signals set from outside, [`Model::inputs`],
+//! [`Model::set_inputs_from_csv`]), [`data`] (CSV files with line/column errors), [`tables`]
+//! (`[tables]`: 1-D and 2-D lookup tables called like functions, with exact derivatives).
+//!
 //! Around a model: [`scene`] (switches between richer and cheaper scenes), [`plots`]
 //! (`[[plot]]` tables), [`describe`] (a kind's parameters, for `bg-sim kinds`).
 //!
@@ -49,6 +53,7 @@
 //! Parameters and element values may be expressions: `"pi/4*d^2"`, `"1/k"`, or, where an
 //! element allows modulation, functions of signals and time: `"1 + 0.1*spring.q"`.
 
+pub mod data;
 pub mod describe;
 pub mod error;
 pub mod expr;
@@ -59,12 +64,14 @@ pub mod reader;
 pub mod registry;
 pub mod scene;
 pub mod steady;
+pub mod tables;
 
+pub use data::DataFile;
 pub use describe::{describe, parameter_table, KindReport};
 pub use error::{ErrorKind, ModelError};
 pub use load::{
-    inspect, solver, structure, Check, CheckResult, Entry, Inspection, Model, Structure,
-    UnknownSolver,
+    inspect, solver, structure, Check, CheckResult, Entry, Extrapolate, Inspection, Model,
+    Structure, UnknownSolver,
 };
 pub use plots::{Panel, Plot, Series};
 pub use reader::{ElementSpec, RawValue};
