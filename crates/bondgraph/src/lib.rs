@@ -99,5 +99,6 @@ pub use partials_check::check_partials;
 pub use radau::{OdeSystem, Radau5, RadauError, RadauOptions, RadauStats, StepReport};
 pub use simulate::{
     check_in_memory, simulate, simulate_into, Event, Method, Outcome, Output, RowSink, Settings,
-    Statistics, Trajectory, WatchReport, MAX_OUTPUT_ROWS, MAX_VALUES_IN_MEMORY, MIN_RTOL,
+    Simulation, Statistics, Trajectory, WatchReport, MAX_OUTPUT_ROWS, MAX_VALUES_IN_MEMORY,
+    MIN_RTOL,
 };
