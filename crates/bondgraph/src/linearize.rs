@@ -15,7 +15,8 @@
 //! frequency), Bode data (magnitude in dB, phase in degrees, unwrapped along the
 //! frequencies) and the DC gain G(0) = D − C A⁻¹ B.
 
-use nalgebra::{Complex, DMatrix, DVector};
+pub use nalgebra::Complex;
+use nalgebra::{DMatrix, DVector};
 
 use crate::equations::{Probe, StateEquations};
 use crate::modes::ModesError;

@@ -63,7 +63,7 @@ pub mod steady;
 pub use describe::{describe, parameter_table, KindReport};
 pub use error::{ErrorKind, ModelError};
 pub use load::{
-    inspect, solver, structure, Check, CheckResult, Entry, Inspection, Model, Structure,
+    inspect, solver, structure, Check, CheckResult, Entry, Inspection, Model, Stepping, Structure,
     UnknownSolver,
 };
 pub use plots::{Panel, Plot, Series};
