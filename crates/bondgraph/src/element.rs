@@ -273,6 +273,12 @@ pub trait Element: Debug {
         let _ = x;
         None
     }
+
+    /// The external input this element is, if it is one ([`Input`](crate::Input): its signal
+    /// is published under the element's bare name and set from outside the model).
+    fn as_input(&self) -> Option<&crate::elements::Input> {
+        None
+    }
 }
 
 /// Bounds on one of an element's states (`f64::NEG_INFINITY` / `f64::INFINITY` for none).

@@ -18,6 +18,7 @@ use crate::element::{Element, Io, Layout, PortLayout, Ports, Slot, Source};
 use crate::error::{CausalityError, GraphError};
 use crate::graph::{check_same_shape, BondGraph};
 
+mod inputs;
 mod jacobian;
 
 /// A named state of the assembled system.
@@ -80,6 +81,10 @@ pub struct StateEquations {
     jac_plan: jacobian::JacobianPlan,
     /// The Jacobian's buffers, allocated by its first call.
     jac_work: RefCell<Option<jacobian::JacobianWork>>,
+    /// The external inputs ([`Input`](crate::Input) elements), in element order.
+    inputs: Vec<ElementId>,
+    /// Whether a run stops and restarts at the inputs' breakpoints (default: yes).
+    stop_at_breakpoints: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -134,7 +139,13 @@ impl StateEquations {
             }
             for s in node.element.signal_outputs() {
                 layout.outputs.push((n_signals, s.dim));
-                signal_names.push((format!("{}.{}", node.name, s.name), n_signals, s.dim));
+                // an input publishes its one signal under its bare name (`F`)
+                let name = if node.element.as_input().is_some() {
+                    node.name.clone()
+                } else {
+                    format!("{}.{}", node.name, s.name)
+                };
+                signal_names.push((name, n_signals, s.dim));
                 n_signals += s.dim;
             }
             for (port, b) in graph.ports_of(id).iter().enumerate() {
@@ -173,7 +184,12 @@ impl StateEquations {
             ws: RefCell::new(Workspace::default()),
             jac_plan: jacobian::JacobianPlan::default(),
             jac_work: RefCell::new(None),
+            inputs: Vec::new(),
+            stop_at_breakpoints: true,
         };
+        eqs.inputs = (0..n_el)
+            .filter(|&id| eqs.graph.node(id).element.as_input().is_some())
+            .collect();
         eqs.resolve_inputs()?;
         eqs.plan()?;
         eqs.jac_plan = eqs.jacobian_plan();

@@ -184,6 +184,13 @@ pub enum GraphError {
         /// The name.
         name: String,
     },
+    /// An input named (or numbered) in an API call does not exist.
+    UnknownInput {
+        /// The name (or `#index`).
+        name: String,
+        /// The inputs there are, or the near miss.
+        hint: String,
+    },
     /// A replacement element (scheduled event) does not have the shape of the original.
     Replacement {
         /// Element name.
@@ -251,6 +258,7 @@ impl GraphError {
                 "element `{element}` reads signal `{signal}` of dimension {found}, but needs {expected}"
             ),
             Self::UnknownElement { name } => format!("no element named `{name}`"),
+            Self::UnknownInput { name, .. } => format!("the model has no input `{name}`"),
             Self::Replacement {
                 element, message, ..
             } => format!("element `{element}` cannot be replaced: {message}"),
@@ -271,7 +279,7 @@ impl GraphError {
             Self::NoFreePort { .. } => "connect several bonds through a junction",
             Self::Unconnected { .. } => "every port of an element needs exactly one bond",
             Self::EmptyJunction { .. } => "remove it or connect it",
-            Self::UnknownSignal { hint, .. } => hint,
+            Self::UnknownSignal { hint, .. } | Self::UnknownInput { hint, .. } => hint,
             Self::Replacement { hint, .. } => return hint.clone(),
             _ => return None,
         };

@@ -15,10 +15,12 @@
 //! | `lag` | [`Lag`] | τ·dy/dt = u − y |
 //! | `p_control` | [`PController`] | y = clamp(K·(r − u), lo, hi) |
 //! | `signal` | [`SignalFunction`] | y = g(t, signals) |
+//! | (`[inputs]`) | [`Input`] | y = u(t), set from outside |
 
 pub(crate) mod capacitor;
 pub(crate) mod gyrator;
 pub(crate) mod inertia;
+pub(crate) mod input;
 pub(crate) mod junction;
 pub(crate) mod lag;
 pub(crate) mod matrix_transformer;
@@ -31,6 +33,7 @@ pub(crate) mod transformer;
 pub use capacitor::Capacitor;
 pub use gyrator::Gyrator;
 pub use inertia::Inertia;
+pub use input::{Input, InputSpec, Interp, Series};
 pub use junction::{OneJunction, ZeroJunction};
 pub use lag::Lag;
 pub use matrix_transformer::{

@@ -11,7 +11,10 @@
 //!   products multiply by it, assembled once per (t, x) (`segment.rs`).
 //! * Results are written at the output times `t0, t0 + Δ, …, t_end` by the method's dense
 //!   interpolation; the solver steps onto every scheduled event time exactly, the event
-//!   replaces elements (a parameter switch), and the solver restarts from there. The output
+//!   replaces elements (a parameter switch), and the solver restarts from there. It stops
+//!   and restarts likewise at the breakpoints of the external inputs' series
+//!   ([`StateEquations::next_breakpoint`], unless turned off), each segment evaluating every
+//!   series on one piece ([`StateEquations::begin_segment`]). The output
 //!   row at an event time is computed after the switch. Element limits are located by root
 //!   finding (diffsol's, or bisection on Radau's dense output: `radau.rs`).
 //! * After every accepted step the state is checked: a NaN or infinity stops the run with the
@@ -769,7 +772,10 @@ pub fn simulate_into(
         if out.error.is_some() {
             break;
         }
-        let t_stop = events.peek().map_or(t_end, |e| e.t.min(t_end));
+        let t_event = events.peek().map_or(t_end, |e| e.t.min(t_end));
+        // The inputs' next breakpoint (a sample's corner) is a stop too, not an event.
+        let t_stop = eqs.next_breakpoint(t).map_or(t_event, |b| b.min(t_event));
+        eqs.begin_segment(t);
         let mut rec = Recorder {
             eqs,
             outputs,
@@ -777,7 +783,7 @@ pub fn simulate_into(
             sink: &mut *sink,
             interrupt,
             wants_steps,
-            event_at: (t_stop < t_end).then_some(t_stop),
+            event_at: (t_event < t_end && same_time(t_event, t_stop)).then_some(t_stop),
             buf: std::mem::take(&mut buf),
             p: progress,
         };
@@ -826,6 +832,7 @@ pub fn simulate_into(
             }
         }
     }
+    eqs.end_segment();
     out.rows = progress.rows;
     out.watched = reports(progress.watchers);
     out.t_final = t;
