@@ -238,6 +238,93 @@ mod tests {
         assert_eq!((lin.b.ncols(), lin.d.shape()), (0, (3, 0)));
     }
 
+    /// The MSD driven by an input `F` through a modulated effort source.
+    fn msd_with_input() -> StateEquations {
+        let mut g = BondGraph::new();
+        let spec = crate::InputSpec {
+            name: "F".into(),
+            unit: "N".into(),
+            default: 0.0,
+            description: "force".into(),
+        };
+        g.add("F", crate::Input::new(spec).unwrap()).unwrap();
+        let force = EffortSource::new(crate::Param::modulated(vec!["F".into()], |_, u| u[0]));
+        g.add("force", force).unwrap();
+        g.add("v", OneJunction).unwrap();
+        g.add("mass", Inertia::new(1.0, 0.0).unwrap()).unwrap();
+        g.add("spring", Capacitor::new(0.01, 0.0).unwrap()).unwrap();
+        g.add("damper", Resistor::new(2.0).unwrap()).unwrap();
+        for (a, b) in [
+            ("force", "v"),
+            ("v", "mass"),
+            ("v", "spring"),
+            ("v", "damper"),
+        ] {
+            g.connect_names(a, b).unwrap();
+        }
+        StateEquations::new(assign_causality(g).unwrap()).unwrap()
+    }
+
+    /// B = ∂f/∂F and D: exact; the DC gain is 1/k; |G(jω)| = 1/|k − mω² + jcω|; the force
+    /// itself as an output has D = 1.
+    #[test]
+    fn input_columns_dc_gain_and_frequency_response() {
+        let eqs = msd_with_input();
+        let x = eqs.initial_state();
+        let f = eqs.input_signal_offset(0).unwrap();
+        let outputs = [
+            ("x".to_owned(), eqs.probe("spring.q").unwrap()),
+            ("force".to_owned(), eqs.probe("force.e").unwrap()),
+            ("P".to_owned(), eqs.probe("force.P").unwrap()),
+        ];
+        let lin = linearize(&eqs, 0.0, &x, &[("F".into(), f)], &outputs).unwrap();
+        let ip = lin.states.iter().position(|s| s == "mass.p").unwrap();
+        let iq = lin.states.iter().position(|s| s == "spring.q").unwrap();
+        assert_eq!(lin.b[(ip, 0)], 1.0, "dp/dt = F − …");
+        assert_eq!(lin.b[(iq, 0)], 0.0);
+        assert_eq!(lin.d[(0, 0)], 0.0);
+        assert_eq!(lin.d[(1, 0)], 1.0, "the source's effort is F");
+        assert_eq!(lin.d[(2, 0)], 0.0, "P = F·v, v = 0 at rest");
+        let dc = lin.dc_gain(0, 0).unwrap();
+        assert!((dc - 0.01).abs() < 1e-15, "{dc}");
+        let mut worst = 0.0f64;
+        for w in [0.1, 1.0, 9.0, 10.0, 99f64.sqrt(), 30.0, 300.0] {
+            let g = lin.response(0, 0, w).unwrap();
+            let want = 1.0 / Complex::new(100.0 - w * w, 2.0 * w);
+            worst = worst.max((g - want).norm() / want.norm());
+        }
+        assert!(worst < 1e-12, "{worst}");
+        let b = lin.bode(0, 0, &log_frequencies(0.01, 100.0, 200));
+        assert!((b[0].db - 20.0 * 0.01f64.log10()).abs() < 1e-3);
+        assert!(
+            b[0].phase_deg.abs() < 0.1 && (b[199].phase_deg + 180.0).abs() < 1.0,
+            "{:?}",
+            b[199]
+        );
+        // the phase is unwrapped: it falls monotonically from 0 to −180°
+        assert!(b
+            .windows(2)
+            .all(|p| p[1].phase_deg <= p[0].phase_deg + 1e-9));
+        // B against a central difference of f in F at a state away from rest
+        let x1 = [0.3, -0.02];
+        let lin1 = linearize(&eqs, 0.0, &x1, &[("F".into(), f)], &outputs).unwrap();
+        let mut fp = [0.0; 2];
+        let mut fm = [0.0; 2];
+        eqs.set_input(0, 1e-3).unwrap();
+        eqs.rhs(0.0, &x1, &mut fp);
+        eqs.set_input(0, -1e-3).unwrap();
+        eqs.rhs(0.0, &x1, &mut fm);
+        for i in 0..2 {
+            assert!((lin1.b[(i, 0)] - (fp[i] - fm[i]) / 2e-3).abs() < 1e-9);
+        }
+        // P = F·v: ∂P/∂F = v = p/m at x1
+        assert!(
+            (lin1.d[(2, 0)] - x1[ip]).abs() < 1e-15,
+            "{}",
+            lin1.d[(2, 0)]
+        );
+    }
+
     #[test]
     fn log_frequencies_span_the_range() {
         let f = log_frequencies(0.1, 100.0, 4);

@@ -12,7 +12,8 @@
 //! about as much as a right-hand side) — no Jacobian per call.
 //!
 //! What changes the equations at the current time without a jump of the state — an input
-//! set to a new value ([`Simulation::equations_changed`]) — costs one right-hand side: the
+//! set to a new value ([`Simulation::set_input`]), a corner of an input's series (a stop, as
+//! in a run) — costs one right-hand side: the
 //! integrator evaluates f(t, y) anew and keeps its step size, Jacobian and LU (Newton renews
 //! the Jacobian itself when it converges slowly; the error test shrinks a step the change
 //! made too long). A scheduled [`Event`] (elements replaced) and [`Simulation::restart`] make
@@ -205,6 +206,37 @@ impl Simulation {
         }
     }
 
+    /// Hold input `i` at `value` from now on. A new value changes f at the current time:
+    /// the integrator re-evaluates it before the next step and keeps its step size,
+    /// Jacobian and LU ([`Self::equations_changed`]); the same value changes nothing.
+    ///
+    /// # Errors
+    /// [`GraphError::UnknownInput`](crate::GraphError::UnknownInput) for an index out of range.
+    pub fn set_input(&mut self, i: usize, value: f64) -> Result<(), crate::GraphError> {
+        let t = self.t();
+        let same = self.eqs.input_series(i)?.is_none()
+            && self.eqs.input_value(i, t)?.to_bits() == value.to_bits();
+        if !same {
+            self.eqs.set_input(i, value)?;
+            self.equations_changed();
+        }
+        Ok(())
+    }
+
+    /// Make input `i` follow `series` from now on (its corners become stops, as in a run).
+    ///
+    /// # Errors
+    /// [`GraphError::UnknownInput`](crate::GraphError::UnknownInput) for an index out of range.
+    pub fn set_input_series(
+        &mut self,
+        i: usize,
+        series: crate::elements::Series,
+    ) -> Result<(), crate::GraphError> {
+        self.eqs.set_input_series(i, series)?;
+        self.equations_changed();
+        Ok(())
+    }
+
     /// Restart the integrator at the current time, optionally from a new state: the
     /// Jacobian, its LU and the step-size history are forgotten.
     ///
@@ -302,8 +334,16 @@ impl Simulation {
             }
             let next_event = self.events.last().map(|e| e.t);
             let t_stop = next_event.map_or(t_target, |te| te.min(t_target));
+            // An input series' corner is a stop too: the series is evaluated on one piece
+            // up to it, and f changes there as it does when an input is set.
+            let corner = self.eqs.next_breakpoint(t).filter(|&b| b < t_stop);
+            let t_stop = corner.unwrap_or(t_stop);
+            self.eqs.begin_segment(t);
             if !same_time(t, t_stop) {
                 self.integrate(t_stop)?;
+            }
+            if corner.is_some() {
+                self.equations_changed();
             }
             if next_event.is_some_and(|te| same_time(te, t_stop) || te <= t_stop) {
                 while self
@@ -523,6 +563,59 @@ mod tests {
             after.lu_factorisations - before.lu_factorisations <= 3 * 100,
             "{after}"
         );
+    }
+
+    /// The same through an external input: set to a new value between calls, the same value
+    /// again costs nothing; a series' corner inside a call is a stop.
+    #[test]
+    fn an_input_set_between_calls_and_a_series_corner() {
+        let s = settings();
+        let mut g = BondGraph::new();
+        let spec = crate::InputSpec {
+            name: "F".into(),
+            unit: "N".into(),
+            default: 10.0,
+            description: String::new(),
+        };
+        g.add("F", crate::Input::new(spec).unwrap()).unwrap();
+        let force = EffortSource::new(crate::Param::modulated(vec!["F".into()], |_, u| u[0]));
+        g.add("force", force).unwrap();
+        g.add("v", OneJunction).unwrap();
+        g.add("mass", Inertia::new(1.0, 0.0).unwrap()).unwrap();
+        g.add("spring", Capacitor::new(0.01, 0.0).unwrap()).unwrap();
+        g.add("damper", Resistor::new(2.0).unwrap()).unwrap();
+        for (a, b) in [
+            ("force", "v"),
+            ("v", "mass"),
+            ("v", "spring"),
+            ("v", "damper"),
+        ] {
+            g.connect_names(a, b).unwrap();
+        }
+        let eqs = StateEquations::new(assign_causality(g).unwrap()).unwrap();
+        let x0 = eqs.initial_state();
+        let probe = eqs.probe("spring.q").unwrap();
+        let mut sim = Simulation::start(eqs, 0.0, &x0, &s, vec![]).unwrap();
+        for k in 1..=100 {
+            sim.set_input(0, 10.0).unwrap(); // unchanged: nothing happens
+            sim.advance_to(k as f64 * 0.01).unwrap();
+        }
+        let rhs_before = sim.stats().rhs_evals;
+        sim.set_input(0, 20.0).unwrap();
+        for k in 101..=200 {
+            sim.advance_to(k as f64 * 0.01).unwrap();
+        }
+        assert!(sim.stats().rhs_evals > rhs_before);
+        let want = exact(2.0) + exact(1.0);
+        assert!((sim.read(probe) - want).abs() < 1e-8);
+        // a held series stepping back to 10 N at t = 2.505, inside the next call
+        let series =
+            crate::Series::new(vec![2.0, 2.505], vec![20.0, 10.0], crate::Interp::Hold).unwrap();
+        sim.set_input_series(0, series).unwrap();
+        sim.advance_to(3.0).unwrap();
+        let want = exact(3.0) + exact(2.0) - exact(3.0 - 2.505);
+        let got = sim.read(probe);
+        assert!((got - want).abs() < 1e-8, "{got} vs {want}");
     }
 
     #[test]

@@ -18,14 +18,9 @@ impl RowSink for Discard {
 
 /// The signal offset of the input called `name`.
 fn input_signal(eqs: &StateEquations, file: &str, name: &str) -> Result<usize, ModelError> {
-    Err(request_error(
-        file,
-        format!("`{name}` is no input of the model"),
-        Some(format!(
-            "the model declares no inputs: add `{name}` to its [inputs] table ({} states)",
-            eqs.n_states()
-        )),
-    ))
+    eqs.input_index(name)
+        .and_then(|i| eqs.input_signal_offset(i))
+        .map_err(|e| request_error(file, format!("`{name}` is no input of the model"), e.hint()))
 }
 
 /// The named inputs (their signals) and outputs (their probes) of `eqs`.

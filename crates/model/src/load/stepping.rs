@@ -160,6 +160,55 @@ impl Stepping {
         Ok(self.read(self.probe(name)?))
     }
 
+    /// The model's inputs, in order.
+    #[must_use]
+    pub fn input_names(&self) -> Vec<String> {
+        self.sim
+            .equations()
+            .inputs()
+            .into_iter()
+            .map(|u| u.name)
+            .collect()
+    }
+
+    /// Hold the input `name` at `value` from now on. A new value changes the equations at
+    /// the current time: the integrator evaluates them anew and keeps its step size,
+    /// Jacobian and LU (no restart); the same value costs nothing.
+    ///
+    /// # Errors
+    /// An unknown input (with "did you mean"), a value that is not finite.
+    pub fn set_input(&mut self, name: &str, value: f64) -> Result<(), ModelError> {
+        let bad = |message: String, hint: Option<String>| request_error(&self.file, message, hint);
+        if !value.is_finite() {
+            return Err(bad(
+                format!("input `{name}` set to {value}: it must be finite"),
+                None,
+            ));
+        }
+        let i = self
+            .sim
+            .equations()
+            .input_index(name)
+            .map_err(|e| bad(e.message(), e.hint()))?;
+        self.sim
+            .set_input(i, value)
+            .map_err(|e| bad(e.message(), e.hint()))
+    }
+
+    /// Make the input `name` follow `series` from now on (its samples' times become stops).
+    ///
+    /// # Errors
+    /// An unknown input (with "did you mean").
+    pub fn set_input_series(
+        &mut self,
+        name: &str,
+        series: bondgraph::elements::Series,
+    ) -> Result<(), ModelError> {
+        let bad = |e: bondgraph::GraphError| request_error(&self.file, e.message(), e.hint());
+        let i = self.sim.equations().input_index(name).map_err(bad)?;
+        self.sim.set_input_series(i, series).map_err(bad)
+    }
+
     /// Advance to `t` (landing on it exactly).
     ///
     /// # Errors
