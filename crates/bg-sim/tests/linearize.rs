@@ -49,7 +49,10 @@ fn crane_poles_equal_modes() {
         .iter()
         .map(|m| (m["re"].as_f64().unwrap(), m["im"].as_f64().unwrap()))
         .collect();
-    let expected = modes.iter().map(|m| if m.1 > 0.0 { 2 } else { 1 }).sum::<usize>();
+    let expected = modes
+        .iter()
+        .map(|m| if m.1 > 0.0 { 2 } else { 1 })
+        .sum::<usize>();
     assert_eq!(poles.len(), expected);
     assert_eq!(poles.len(), 38);
     let scale = poles.iter().map(|p| p.0.hypot(p.1)).fold(0.0, f64::max);
@@ -92,7 +95,12 @@ fn unknown_names_and_bad_options_exit_2() {
     }
     let out = bg_sim()
         .current_dir(root())
-        .args(["linearize", "models/mass_spring_damper.toml", "--outputs", "xx"])
+        .args([
+            "linearize",
+            "models/mass_spring_damper.toml",
+            "--outputs",
+            "xx",
+        ])
         .output()
         .unwrap();
     assert!(String::from_utf8_lossy(&out.stderr).contains("did you mean `x`"));
@@ -117,7 +125,10 @@ fn free_mass_spring_damper_poles() {
         let wd = (10.0f64 - 0.0625).sqrt();
         for p in lin["poles"].as_array().unwrap() {
             let (re, im) = (p["re"].as_f64().unwrap(), p["im"].as_f64().unwrap());
-            assert!((re + 0.25).abs() < 1e-12 && (im.abs() - wd).abs() < 1e-12, "{p}");
+            assert!(
+                (re + 0.25).abs() < 1e-12 && (im.abs() - wd).abs() < 1e-12,
+                "{p}"
+            );
         }
         assert_eq!(lin["C"], serde_json::json!([[0.0, 1.0], [1.0, 0.0]]));
     }
