@@ -312,6 +312,10 @@ pub struct Watch {
 /// The law of a modulated [`Param`]: `value = law(t, inputs)`.
 pub type ParamLaw = Box<dyn Fn(f64, &[f64]) -> f64>;
 
+/// The exact gradient law of a modulated [`Param`]: returns the value at `(t, inputs)` and
+/// writes ∂value/∂inputₖ into `grad[k]` (one entry per input).
+pub type ParamGradient = Box<dyn Fn(f64, &[f64], &mut [f64]) -> f64>;
+
 /// A coefficient that is either constant or a function of time and scalar signal inputs
 /// (a *modulated* parameter: the ratio of an MTF, the resistance of a valve, a source value).
 pub enum Param {
@@ -323,6 +327,8 @@ pub enum Param {
         inputs: Vec<String>,
         /// The law.
         law: ParamLaw,
+        /// Its exact gradient, if known (else [`Param::partials`] differences `law`).
+        gradient: Option<ParamGradient>,
     },
 }
 
@@ -335,6 +341,21 @@ impl Param {
         Self::Modulated {
             inputs,
             law: Box::new(law),
+            gradient: None,
+        }
+    }
+    /// A modulated parameter whose exact gradient is known: `gradient(t, u, grad)` returns
+    /// the value and writes ∂value/∂uₖ into `grad[k]` (a compiled expression's forward mode,
+    /// a lookup table's slope). [`Param::partials`] then uses it instead of differences.
+    pub fn modulated_exact(
+        inputs: Vec<String>,
+        law: impl Fn(f64, &[f64]) -> f64 + 'static,
+        gradient: impl Fn(f64, &[f64], &mut [f64]) -> f64 + 'static,
+    ) -> Self {
+        Self::Modulated {
+            inputs,
+            law: Box::new(law),
+            gradient: Some(Box::new(gradient)),
         }
     }
     /// Signals read, as specs (scalar).
@@ -368,7 +389,7 @@ impl Param {
     pub fn value(&self, io: &Io<'_>, first: usize) -> f64 {
         match self {
             Self::Const(v) => *v,
-            Self::Modulated { inputs, law } => {
+            Self::Modulated { inputs, law, .. } => {
                 let n = inputs.len();
                 if n > MAX_PARAM_INPUTS {
                     let v: Vec<f64> = (0..n).map(|k| io.u(first + k)).collect();
@@ -387,14 +408,32 @@ impl Param {
     /// `first..first + n_inputs`): calls `f(k, ∂value/∂u_k)` for each input k; nothing for
     /// a constant.
     ///
-    /// A law is a closure, so the derivatives are central differences of the law alone
+    /// With an exact gradient ([`Param::modulated_exact`]) the derivatives are exact;
+    /// otherwise a law is a closure, so they are central differences of the law alone
     /// (step ∛ε·max(|u|, 1e-3); error about 1e-10 relative for smooth laws): cheap, and
     /// free of allocation for up to [`MAX_PARAM_INPUTS`] inputs.
     pub fn partials(&self, io: &Io<'_>, first: usize, mut f: impl FnMut(usize, f64)) {
-        let Self::Modulated { inputs, law } = self else {
+        let Self::Modulated {
+            inputs,
+            law,
+            gradient,
+        } = self
+        else {
             return;
         };
         let n = inputs.len();
+        if let (Some(grad), true) = (gradient, n <= MAX_PARAM_INPUTS) {
+            let mut u = [0.0; MAX_PARAM_INPUTS];
+            let mut g = [0.0; MAX_PARAM_INPUTS];
+            for (k, b) in u.iter_mut().take(n).enumerate() {
+                *b = io.u(first + k);
+            }
+            let _ = grad(io.time(), &u[..n], &mut g[..n]);
+            for (k, d) in g.iter().take(n).enumerate() {
+                f(k, *d);
+            }
+            return;
+        }
         let mut small = [0.0; MAX_PARAM_INPUTS];
         let mut large = Vec::new();
         let u: &mut [f64] = if n > MAX_PARAM_INPUTS {

@@ -34,6 +34,12 @@ pub enum ErrorKind {
     Scene,
     /// A `[[plot]]` table is wrong, or names a column the results do not have.
     Plot,
+    /// A data file (inputs, tables) is wrong: a cell, a row, its times, its coverage.
+    Data,
+    /// An `[inputs]` entry, or a data column given to an input, is wrong.
+    Input,
+    /// A `[tables]` entry is wrong.
+    Table,
 }
 
 /// A problem in a model file.
@@ -162,6 +168,9 @@ impl ErrorKind {
             Self::Settings => "settings",
             Self::Scene => "scene",
             Self::Plot => "plot",
+            Self::Data => "data",
+            Self::Input => "input",
+            Self::Table => "table",
         }
     }
 }

@@ -5,6 +5,9 @@
 //! the functions listed in [`FUNCTIONS`]. Always floating point: `1/2` is 0.5.
 
 use std::fmt;
+use std::sync::Arc;
+
+use crate::tables::Tables;
 
 mod parser;
 use parser::Parser;
@@ -90,7 +93,18 @@ impl Expr {
             });
         }
         let chars: Vec<char> = src.chars().collect();
-        Parser::whole(&chars)
+        Parser::whole(&chars, &[])
+    }
+
+    /// Parse `src`, where the lookup tables `tables` (name, number of arguments) may be
+    /// called like functions: `eta(n, dp)`.
+    pub fn parse_with(src: &str, tables: &[(String, usize)]) -> Result<Self, ExprError> {
+        let n = src.chars().count();
+        if n > MAX_EXPR_LEN {
+            return Self::parse(src);
+        }
+        let chars: Vec<char> = src.chars().collect();
+        Parser::whole(&chars, tables)
     }
 
     /// Every name used, in order of first appearance.
@@ -143,13 +157,28 @@ impl Expr {
         constant: &dyn Fn(&str) -> Option<f64>,
         inputs: &[String],
     ) -> Result<Compiled, String> {
-        Ok(Compiled(self.lower(constant, inputs)?))
+        self.compile_with(constant, inputs, &Arc::new(Tables::default()))
+    }
+
+    /// [`compile`](Self::compile) where the lookup tables `tables` may be called.
+    pub fn compile_with(
+        &self,
+        constant: &dyn Fn(&str) -> Option<f64>,
+        inputs: &[String],
+        tables: &Arc<Tables>,
+    ) -> Result<Compiled, String> {
+        Ok(Compiled {
+            root: self.lower(constant, inputs, tables)?,
+            tables: Arc::clone(tables),
+            n_inputs: inputs.len(),
+        })
     }
 
     fn lower(
         &self,
         constant: &dyn Fn(&str) -> Option<f64>,
         inputs: &[String],
+        tables: &Tables,
     ) -> Result<Node, String> {
         Ok(match self {
             Self::Num(v) => Node::Num(*v),
@@ -163,75 +192,232 @@ impl Expr {
                     return Err(format!("unknown name `{n}`"));
                 }
             }
-            Self::Neg(a) => Node::Neg(Box::new(a.lower(constant, inputs)?)),
+            Self::Neg(a) => Node::Neg(Box::new(a.lower(constant, inputs, tables)?)),
             Self::Bin(op, a, b) => Node::Bin(
-                *op,
-                Box::new(a.lower(constant, inputs)?),
-                Box::new(b.lower(constant, inputs)?),
+                Op::of(*op),
+                Box::new(a.lower(constant, inputs, tables)?),
+                Box::new(b.lower(constant, inputs, tables)?),
             ),
-            Self::Call(f, args) => Node::Call(
-                f.clone(),
-                args.iter()
-                    .map(|a| a.lower(constant, inputs))
-                    .collect::<Result<_, _>>()?,
-            ),
+            Self::Call(f, args) => {
+                let func = tables
+                    .index(f)
+                    .map(Func::Table)
+                    .or_else(|| Func::of(f))
+                    .ok_or_else(|| format!("unknown function `{f}`"))?;
+                Node::Call(
+                    func,
+                    args.iter()
+                        .map(|a| a.lower(constant, inputs, tables))
+                        .collect::<Result<_, _>>()?,
+                )
+            }
         })
     }
 }
 
+/// A binary operator, lowered from its character.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Op {
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Pow,
+}
+
+impl Op {
+    fn of(c: char) -> Self {
+        match c {
+            '+' => Self::Add,
+            '-' => Self::Sub,
+            '*' => Self::Mul,
+            '/' => Self::Div,
+            _ => Self::Pow,
+        }
+    }
+    fn apply(self, a: f64, b: f64) -> f64 {
+        match self {
+            Self::Add => a + b,
+            Self::Sub => a - b,
+            Self::Mul => a * b,
+            Self::Div => a / b,
+            Self::Pow => a.powf(b),
+        }
+    }
+}
+
 fn binary(op: char, a: f64, b: f64) -> f64 {
-    match op {
-        '+' => a + b,
-        '-' => a - b,
-        '*' => a * b,
-        '/' => a / b,
-        _ => a.powf(b),
+    Op::of(op).apply(a, b)
+}
+
+/// A function, lowered from its name once at compile time (no string work in the rhs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Func {
+    Sqrt,
+    Exp,
+    Ln,
+    Log10,
+    Sin,
+    Cos,
+    Tan,
+    Asin,
+    Acos,
+    Atan,
+    Atan2,
+    Sinh,
+    Cosh,
+    Tanh,
+    Abs,
+    Sign,
+    Step,
+    Pow,
+    Min,
+    Max,
+    Clamp,
+    Deg,
+    Rad,
+    /// Lookup table `k` of the model's [`Tables`].
+    Table(usize),
+}
+
+impl Func {
+    fn of(name: &str) -> Option<Self> {
+        Some(match name {
+            "sqrt" => Self::Sqrt,
+            "exp" => Self::Exp,
+            "ln" => Self::Ln,
+            "log10" => Self::Log10,
+            "sin" => Self::Sin,
+            "cos" => Self::Cos,
+            "tan" => Self::Tan,
+            "asin" => Self::Asin,
+            "acos" => Self::Acos,
+            "atan" => Self::Atan,
+            "atan2" => Self::Atan2,
+            "sinh" => Self::Sinh,
+            "cosh" => Self::Cosh,
+            "tanh" => Self::Tanh,
+            "abs" => Self::Abs,
+            "sign" => Self::Sign,
+            "step" => Self::Step,
+            "pow" => Self::Pow,
+            "min" => Self::Min,
+            "max" => Self::Max,
+            "clamp" => Self::Clamp,
+            "deg" => Self::Deg,
+            "rad" => Self::Rad,
+            _ => return None,
+        })
+    }
+
+    /// The value at `v`; with `d`, the partial derivative with respect to each argument
+    /// (exact; at a kink, one side's).
+    fn apply(self, v: &[f64], tables: &Tables, d: Option<&mut [f64]>) -> f64 {
+        let x = v[0];
+        let (value, slope): (f64, f64) = match self {
+            Self::Sqrt => (x.sqrt(), 0.5 / x.sqrt()),
+            Self::Exp => (x.exp(), x.exp()),
+            Self::Ln => (x.ln(), 1.0 / x),
+            Self::Log10 => (x.log10(), 1.0 / (x * std::f64::consts::LN_10)),
+            Self::Sin => (x.sin(), x.cos()),
+            Self::Cos => (x.cos(), -x.sin()),
+            Self::Tan => (x.tan(), 1.0 + x.tan() * x.tan()),
+            Self::Asin => (x.asin(), 1.0 / (1.0 - x * x).sqrt()),
+            Self::Acos => (x.acos(), -1.0 / (1.0 - x * x).sqrt()),
+            Self::Atan => (x.atan(), 1.0 / (1.0 + x * x)),
+            Self::Sinh => (x.sinh(), x.cosh()),
+            Self::Cosh => (x.cosh(), x.sinh()),
+            Self::Tanh => (x.tanh(), 1.0 - x.tanh() * x.tanh()),
+            Self::Abs => (x.abs(), if x >= 0.0 { 1.0 } else { -1.0 }),
+            Self::Sign => (
+                if x > 0.0 {
+                    1.0
+                } else if x < 0.0 {
+                    -1.0
+                } else {
+                    0.0
+                },
+                0.0,
+            ),
+            Self::Step => (if x >= 0.0 { 1.0 } else { 0.0 }, 0.0),
+            Self::Deg => (x.to_degrees(), 180.0 / std::f64::consts::PI),
+            Self::Rad => (x.to_radians(), std::f64::consts::PI / 180.0),
+            Self::Atan2 => {
+                let (y, x) = (v[0], v[1]);
+                if let Some(d) = d {
+                    let r2 = x * x + y * y;
+                    d[0] = x / r2;
+                    d[1] = -y / r2;
+                }
+                return y.atan2(x);
+            }
+            Self::Pow => {
+                let (a, b) = (v[0], v[1]);
+                let p = a.powf(b);
+                if let Some(d) = d {
+                    d[0] = b * a.powf(b - 1.0);
+                    d[1] = if p == 0.0 { 0.0 } else { p * a.ln() };
+                }
+                return p;
+            }
+            Self::Min | Self::Max => {
+                let mut k = 0;
+                for (j, w) in v.iter().enumerate() {
+                    let better = if self == Self::Min {
+                        *w < v[k]
+                    } else {
+                        *w > v[k]
+                    };
+                    if better || w.is_nan() {
+                        k = j;
+                    }
+                }
+                if let Some(d) = d {
+                    d.iter_mut().for_each(|x| *x = 0.0);
+                    d[k] = 1.0;
+                }
+                return v[k];
+            }
+            Self::Clamp => {
+                // bounds in the wrong order give NaN, which the run reports, not a silent `hi`
+                if v[1] > v[2] {
+                    return f64::NAN;
+                }
+                let k = if v[0] < v[1] {
+                    1
+                } else if v[0] > v[2] {
+                    2
+                } else {
+                    0
+                };
+                if let Some(d) = d {
+                    d[..3].iter_mut().for_each(|x| *x = 0.0);
+                    d[k] = 1.0;
+                }
+                return v[k];
+            }
+            Self::Table(k) => {
+                let Some(t) = tables.list.get(k) else {
+                    return f64::NAN;
+                };
+                let mut dd = [0.0; 2];
+                let value = t.eval(v, &mut dd);
+                if let Some(d) = d {
+                    let n = d.len().min(2);
+                    d[..n].copy_from_slice(&dd[..n]);
+                }
+                return value;
+            }
+        };
+        if let Some(d) = d {
+            d[0] = slope;
+        }
+        value
     }
 }
 
 fn call(f: &str, v: &[f64]) -> f64 {
-    match f {
-        "sqrt" => v[0].sqrt(),
-        "exp" => v[0].exp(),
-        "ln" => v[0].ln(),
-        "log10" => v[0].log10(),
-        "sin" => v[0].sin(),
-        "cos" => v[0].cos(),
-        "tan" => v[0].tan(),
-        "asin" => v[0].asin(),
-        "acos" => v[0].acos(),
-        "atan" => v[0].atan(),
-        "atan2" => v[0].atan2(v[1]),
-        "sinh" => v[0].sinh(),
-        "cosh" => v[0].cosh(),
-        "tanh" => v[0].tanh(),
-        "abs" => v[0].abs(),
-        "sign" => {
-            if v[0] > 0.0 {
-                1.0
-            } else if v[0] < 0.0 {
-                -1.0
-            } else {
-                0.0
-            }
-        }
-        "step" => {
-            if v[0] >= 0.0 {
-                1.0
-            } else {
-                0.0
-            }
-        }
-        "pow" => v[0].powf(v[1]),
-        "min" => v.iter().copied().fold(f64::INFINITY, f64::min),
-        "max" => v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-        // bounds in the wrong order give NaN, which the run reports, not a silent `hi`
-        "clamp" if v[1] > v[2] => f64::NAN,
-        "clamp" => v[0].max(v[1]).min(v[2]),
-        "deg" => v[0].to_degrees(),
-        "rad" => v[0].to_radians(),
-        _ => f64::NAN,
-    }
+    Func::of(f).map_or(f64::NAN, |func| func.apply(v, &Tables::default(), None))
 }
 
 #[derive(Clone, Debug)]
@@ -239,24 +425,47 @@ enum Node {
     Num(f64),
     Input(usize),
     Neg(Box<Node>),
-    Bin(char, Box<Node>, Box<Node>),
-    Call(String, Vec<Node>),
+    Bin(Op, Box<Node>, Box<Node>),
+    Call(Func, Vec<Node>),
 }
 
-/// A compiled expression: constants folded in, signals read from an input slice.
+/// Most arguments of a function call (`min`, `max`).
+const MAX_ARGS: usize = 8;
+
+/// Most inputs whose gradient [`Compiled::eval_grad`] carries without allocating.
+pub const MAX_GRAD_INPUTS: usize = bondgraph::element::MAX_PARAM_INPUTS;
+
+/// A compiled expression: constants folded in, functions lowered to an enum, signals read
+/// from an input slice, lookup tables shared.
 #[derive(Clone, Debug)]
-pub struct Compiled(Node);
+pub struct Compiled {
+    root: Node,
+    tables: Arc<Tables>,
+    n_inputs: usize,
+}
 
 impl Compiled {
     /// Evaluate with the inputs in the order given to [`Expr::compile`].
     #[must_use]
     pub fn eval(&self, inputs: &[f64]) -> f64 {
-        eval_node(&self.0, inputs)
+        eval_node(&self.root, inputs, &self.tables)
     }
     /// The value if the expression reads no inputs (it may still be NaN or infinite).
     #[must_use]
     pub fn constant(&self) -> Option<f64> {
-        (!reads_inputs(&self.0)).then(|| eval_node(&self.0, &[]))
+        (!reads_inputs(&self.root)).then(|| eval_node(&self.root, &[], &self.tables))
+    }
+    /// The value and, in `grad`, its exact gradient with respect to the inputs (forward
+    /// mode, no allocation; at a kink such as `abs`, `min` or a table's knot, one side's).
+    /// `grad` has one entry per input, at most [`MAX_GRAD_INPUTS`].
+    pub fn eval_grad(&self, inputs: &[f64], grad: &mut [f64]) -> f64 {
+        let n = grad.len().min(MAX_GRAD_INPUTS);
+        grad_node(&self.root, inputs, &self.tables, &mut grad[..n])
+    }
+    /// Whether [`eval_grad`](Self::eval_grad) can carry this expression's gradient.
+    #[must_use]
+    pub fn has_exact_gradient(&self) -> bool {
+        self.n_inputs <= MAX_GRAD_INPUTS
     }
 }
 
@@ -270,19 +479,97 @@ fn reads_inputs(n: &Node) -> bool {
     }
 }
 
-fn eval_node(n: &Node, u: &[f64]) -> f64 {
+fn eval_node(n: &Node, u: &[f64], tables: &Tables) -> f64 {
     match n {
         Node::Num(v) => *v,
         Node::Input(i) => u[*i],
-        Node::Neg(a) => -eval_node(a, u),
-        Node::Bin(op, a, b) => binary(*op, eval_node(a, u), eval_node(b, u)),
+        Node::Neg(a) => -eval_node(a, u, tables),
+        Node::Bin(op, a, b) => op.apply(eval_node(a, u, tables), eval_node(b, u, tables)),
         Node::Call(f, args) => {
-            let mut buf = [0.0; 8];
-            let n = args.len().min(8);
+            let mut buf = [0.0; MAX_ARGS];
+            let n = args.len().min(MAX_ARGS);
             for (k, a) in args.iter().take(n).enumerate() {
-                buf[k] = eval_node(a, u);
+                buf[k] = eval_node(a, u, tables);
             }
-            call(f, &buf[..n])
+            f.apply(&buf[..n], tables, None)
+        }
+    }
+}
+
+/// Value of `n` and its gradient into `g` (zeroed here).
+fn grad_node(n: &Node, u: &[f64], tables: &Tables, g: &mut [f64]) -> f64 {
+    let m = g.len();
+    match n {
+        Node::Num(v) => {
+            g.iter_mut().for_each(|x| *x = 0.0);
+            *v
+        }
+        Node::Input(i) => {
+            g.iter_mut().for_each(|x| *x = 0.0);
+            if *i < m {
+                g[*i] = 1.0;
+            }
+            u[*i]
+        }
+        Node::Neg(a) => {
+            let v = grad_node(a, u, tables, g);
+            g.iter_mut().for_each(|x| *x = -*x);
+            -v
+        }
+        Node::Bin(op, a, b) => {
+            let mut gb = [0.0; MAX_GRAD_INPUTS];
+            let gb = &mut gb[..m];
+            let va = grad_node(a, u, tables, g);
+            let vb = grad_node(b, u, tables, gb);
+            let v = op.apply(va, vb);
+            match op {
+                Op::Add => g.iter_mut().zip(gb.iter()).for_each(|(x, y)| *x += y),
+                Op::Sub => g.iter_mut().zip(gb.iter()).for_each(|(x, y)| *x -= y),
+                Op::Mul => g
+                    .iter_mut()
+                    .zip(gb.iter())
+                    .for_each(|(x, y)| *x = vb * *x + va * y),
+                Op::Div => g
+                    .iter_mut()
+                    .zip(gb.iter())
+                    .for_each(|(x, y)| *x = (*x - v * y) / vb),
+                Op::Pow => {
+                    let da = vb * va.powf(vb - 1.0);
+                    g.iter_mut().zip(gb.iter()).for_each(|(x, y)| {
+                        // the exponent's term only where it varies (a constant exponent of
+                        // a negative base is fine: ln is not taken)
+                        let by_b = if *y == 0.0 || v == 0.0 {
+                            0.0
+                        } else {
+                            v * va.ln() * y
+                        };
+                        *x = if *x == 0.0 { 0.0 } else { da * *x } + by_b;
+                    });
+                }
+            }
+            v
+        }
+        Node::Call(f, args) => {
+            let k = args.len().min(MAX_ARGS);
+            let mut vals = [0.0; MAX_ARGS];
+            for (j, a) in args.iter().take(k).enumerate() {
+                vals[j] = eval_node(a, u, tables);
+            }
+            let mut d = [0.0; MAX_ARGS];
+            let v = f.apply(&vals[..k], tables, Some(&mut d[..k]));
+            g.iter_mut().for_each(|x| *x = 0.0);
+            let mut ga = [0.0; MAX_GRAD_INPUTS];
+            let ga = &mut ga[..m];
+            for (j, a) in args.iter().take(k).enumerate() {
+                if d[j] == 0.0 || !reads_inputs(a) {
+                    continue;
+                }
+                let _ = grad_node(a, u, tables, ga);
+                g.iter_mut()
+                    .zip(ga.iter())
+                    .for_each(|(x, y)| *x += d[j] * y);
+            }
+            v
         }
     }
 }
@@ -415,5 +702,43 @@ mod tests {
             _ => None,
         });
         assert!((c.eval(&[0.5, 1.0]) - want.unwrap()).abs() < 1e-15);
+    }
+
+    /// The forward-mode gradient of every function and operator against central
+    /// differences, and no string work left in a compiled expression.
+    #[test]
+    fn exact_gradients_match_central_differences() {
+        let names: Vec<String> = ["a", "b", "c"].map(String::from).to_vec();
+        let exprs = [
+            "a*b + c/a - b^2",
+            "sqrt(a)*exp(-b) + ln(c)*log10(a)",
+            "sin(a)*cos(b) + tan(c/4) + asin(b/3) + acos(c/4) + atan(a)",
+            "atan2(a, b) + sinh(b) - cosh(c/3) + tanh(a)",
+            "abs(b - 2) + pow(a, c) + a^b + deg(a) + rad(b)",
+            "min(a, b, c) + max(a*2, b) + clamp(a, 0, 1) + clamp(c, 0, 2)",
+            "-a*sign(b) + step(c) + 2^a",
+        ];
+        let u = [0.7, 1.3, 2.6];
+        for src in exprs {
+            let c = Expr::parse(src)
+                .unwrap()
+                .compile(&|_| None, &names)
+                .unwrap();
+            let mut g = [0.0; 3];
+            let v = c.eval_grad(&u, &mut g);
+            assert!((v - c.eval(&u)).abs() < 1e-14 * v.abs().max(1.0), "{src}");
+            for k in 0..3 {
+                let h = 1e-6;
+                let (mut p, mut m) = (u, u);
+                p[k] += h;
+                m[k] -= h;
+                let fd = (c.eval(&p) - c.eval(&m)) / (2.0 * h);
+                assert!(
+                    (fd - g[k]).abs() < 1e-7 * fd.abs().max(1.0),
+                    "{src}: ∂{k} {} vs {fd}",
+                    g[k]
+                );
+            }
+        }
     }
 }

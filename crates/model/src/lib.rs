@@ -49,6 +49,7 @@
 //! Parameters and element values may be expressions: `"pi/4*d^2"`, `"1/k"`, or, where an
 //! element allows modulation, functions of signals and time: `"1 + 0.1*spring.q"`.
 
+pub mod data;
 pub mod describe;
 pub mod error;
 pub mod expr;
@@ -59,12 +60,14 @@ pub mod reader;
 pub mod registry;
 pub mod scene;
 pub mod steady;
+pub mod tables;
 
+pub use data::DataFile;
 pub use describe::{describe, parameter_table, KindReport};
 pub use error::{ErrorKind, ModelError};
 pub use load::{
-    inspect, solver, structure, Check, CheckResult, Entry, Inspection, Model, Stepping, Structure,
-    UnknownSolver,
+    inspect, solver, structure, Check, CheckResult, Entry, Extrapolate, Inspection, Model,
+    Stepping, Structure, UnknownSolver,
 };
 pub use plots::{Panel, Plot, Series};
 pub use reader::{ElementSpec, RawValue};

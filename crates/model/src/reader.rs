@@ -15,6 +15,8 @@ use indexmap::IndexMap;
 
 use crate::error::{clip, line_col, ErrorKind, ModelError};
 use crate::expr::{Compiled, Expr};
+use crate::tables::Tables;
+use std::sync::Arc;
 
 mod params;
 
@@ -42,6 +44,10 @@ pub struct ElementSpec<'a> {
     /// Where a nested table sits (`links[2]`); empty at the top.
     pub(crate) path: String,
     pub(crate) used_constants: &'a RefCell<HashSet<String>>,
+    /// The model's `[inputs]`: bare names read as signals.
+    pub(crate) inputs: &'a [String],
+    /// The model's `[tables]`, callable in expressions.
+    pub(crate) tables: Arc<Tables>,
 }
 
 fn kind_of(e: &BuildError) -> ErrorKind {
@@ -77,6 +83,8 @@ impl<'a> ElementSpec<'a> {
             name_span,
             path: String::new(),
             used_constants,
+            inputs: &[],
+            tables: Arc::new(Tables::default()),
         }
     }
 
@@ -205,7 +213,7 @@ impl<'a> ElementSpec<'a> {
             toml::Value::Integer(i) => Ok(Expr::Num(*i as f64)),
             toml::Value::String(s) => {
                 if let Some((body, unit)) = units::split_value(s) {
-                    if let Ok(e) = Expr::parse(body) {
+                    if let Ok(e) = Expr::parse_with(body, &self.tables.signatures()) {
                         let Some(want) = units::parse(d.unit) else {
                             return Err(self.err(BuildErrorKind::WrongUnit, key, format!("`{key}` is given with a unit, but its unit `{}` cannot be converted", d.unit))
                                 .hint(format!("write `{key}` as a number in {}", d.unit)));
@@ -232,7 +240,7 @@ impl<'a> ElementSpec<'a> {
                         return Ok(Expr::Bin('*', Box::new(Expr::Num(scale)), Box::new(e)));
                     }
                 }
-                Expr::parse(s).map_err(|e| {
+                Expr::parse_with(s, &self.tables.signatures()).map_err(|e| {
                     self.err(BuildErrorKind::Invalid, key, format!("cannot read `{key}` = \"{}\": {e}", clip(s)))
                         .hint("expressions use numbers, parameters, signals like `spring.q`, `t`, + - * / ^ and functions such as sqrt, sin, exp, min, max; a unit may follow after a space (\"200 bar\")")
                 })
@@ -259,20 +267,23 @@ impl<'a> ElementSpec<'a> {
     fn constant(&self, d: &ParamDecl, e: &Expr) -> Result<f64, BuildError> {
         let key = d.name;
         self.note_constants(e);
-        let v = e.eval(&|n| self.constants.get(n).copied()).map_err(|m| {
-            self.err(BuildErrorKind::Invalid, key, format!("`{key}`: {m}"))
-                .hint(format!(
-                    "`{key}` must be constant: use numbers and names from [parameters] ({})",
-                    clip(
-                        &self
-                            .constants
-                            .keys()
-                            .cloned()
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    )
-                ))
-        })?;
+        let v = e
+            .compile_with(&|n| self.constants.get(n).copied(), &[], &self.tables)
+            .map(|c| c.constant().unwrap_or(f64::NAN))
+            .map_err(|m| {
+                self.err(BuildErrorKind::Invalid, key, format!("`{key}`: {m}"))
+                    .hint(format!(
+                        "`{key}` must be constant: use numbers and names from [parameters] ({})",
+                        clip(
+                            &self
+                                .constants
+                                .keys()
+                                .cloned()
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        )
+                    ))
+            })?;
         self.in_range(d, v)
     }
 
@@ -313,14 +324,14 @@ impl<'a> ElementSpec<'a> {
             }
             if self.constants.contains_key(&n) {
                 self.used_constants.borrow_mut().insert(n);
-            } else if n == "t" || n == "time" || n.contains('.') {
+            } else if n == "t" || n == "time" || n.contains('.') || self.inputs.contains(&n) {
                 if !inputs.contains(&n) {
                     inputs.push(n);
                 }
             } else {
                 return Err(self
                     .err(BuildErrorKind::Invalid, key, format!("`{key}` uses `{n}`, which is neither a parameter nor a signal"))
-                    .hint(format!("define `{n}` in [parameters], or name a signal as `<element>.<variable>`; parameters: {}", clip(&self.constants.keys().cloned().collect::<Vec<_>>().join(", ")))));
+                    .hint(format!("define `{n}` in [parameters] or [inputs], or name a signal as `<element>.<variable>`; parameters: {}", clip(&self.constants.keys().cloned().collect::<Vec<_>>().join(", ")))));
             }
         }
         let max = bondgraph::element::MAX_PARAM_INPUTS;
@@ -332,7 +343,7 @@ impl<'a> ElementSpec<'a> {
             ));
         }
         let c = e
-            .compile(&|n| self.constants.get(n).copied(), &inputs)
+            .compile_with(&|n| self.constants.get(n).copied(), &inputs, &self.tables)
             .map_err(|m| self.err(BuildErrorKind::Invalid, key, m))?;
         Ok((c, inputs))
     }
@@ -390,6 +401,8 @@ impl<'a> ElementSpec<'a> {
             name_span: self.name_span.clone(),
             path,
             used_constants: self.used_constants,
+            inputs: self.inputs,
+            tables: Arc::clone(&self.tables),
         };
         spec.validate()?;
         Ok(Box::new(spec))

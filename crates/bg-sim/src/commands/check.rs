@@ -46,10 +46,19 @@ fn check_json(path: &Path, set: &[String]) -> ExitCode {
         .iter()
         .map(|(name, v)| json!({"name": name, "initial": v}))
         .collect();
+    let inputs: Vec<_> = report
+        .inputs
+        .iter()
+        .map(|(s, from)| {
+            json!({"name": s.name, "unit": s.unit, "default": s.default,
+                   "description": s.description, "data": from})
+        })
+        .collect();
     crate::report::document(&json!({
         "file": path.display().to_string(),
         "ok": report.problems.is_empty(),
         "elements": elements,
+        "inputs": inputs,
         "states": states,
         "problems": problems(&report.problems),
         "notes": problems(&report.notes),
@@ -67,6 +76,27 @@ fn check(path: &Path, set: &[String]) -> ExitCode {
         say!("elements ({}):", report.elements.len());
         for (name, kind, line) in &report.elements {
             say!("  {name:<20} {kind:<20} line {line}");
+        }
+    }
+    if !report.inputs.is_empty() {
+        say!("inputs ({}):", report.inputs.len());
+        for (s, from) in &report.inputs {
+            let unit = if s.unit.is_empty() {
+                String::new()
+            } else {
+                format!(" {}", s.unit)
+            };
+            let data = if from.is_empty() {
+                String::new()
+            } else {
+                format!(", from {from}")
+            };
+            let what = if s.description.is_empty() {
+                String::new()
+            } else {
+                format!("  {}", s.description)
+            };
+            say!("  {:<20} default {}{unit}{data}{what}", s.name, s.default);
         }
     }
     if !report.bonds.is_empty() {

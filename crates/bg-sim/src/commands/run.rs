@@ -56,6 +56,57 @@ pub struct Args {
     /// document on stdout; the text report goes to stderr).
     #[arg(long, value_enum, default_value_t = Format::Text)]
     pub format: Format,
+    /// Drive the model's inputs from a CSV: a `t` column and one column per input (any
+    /// subset; the others keep their default).
+    #[arg(long, value_name = "DATA.csv")]
+    pub inputs: Option<PathBuf>,
+    /// How the data go from one sample to the next: linear, or hold (zero-order hold).
+    #[arg(long, value_name = "INTERP", default_value = "linear")]
+    pub inputs_interp: String,
+    /// Outside the data's times: error (the default: the data must cover the run), or hold
+    /// the first and last values.
+    #[arg(long, value_name = "WHAT", default_value = "error")]
+    pub inputs_extrapolate: String,
+    /// Do not stop and restart the solver at every sample of the data (for dense data: the
+    /// solver's error control alone deals with the corners).
+    #[arg(long)]
+    pub no_breakpoints: bool,
+}
+
+/// How `run` drives the model's inputs (`--inputs`, `--inputs-interp`,
+/// `--inputs-extrapolate`, `--no-breakpoints`).
+struct InputOptions {
+    data: Option<PathBuf>,
+    interp: String,
+    extrapolate: String,
+    no_breakpoints: bool,
+}
+
+impl InputOptions {
+    /// Apply them to `model` (after its settings are final: coverage is checked against
+    /// them); a refusal as the message to print.
+    fn apply(&self, model: &mut Model) -> Result<(), String> {
+        model.set_stop_at_breakpoints(!self.no_breakpoints);
+        let Some(path) = &self.data else {
+            return Ok(());
+        };
+        let interp = bondgraph::Interp::parse(&self.interp).ok_or_else(|| {
+            format!(
+                "--inputs-interp {}: not an interpolation\n  hint: linear or hold",
+                self.interp
+            )
+        })?;
+        let extrapolate = bg_model::Extrapolate::parse(&self.extrapolate).ok_or_else(|| {
+            format!(
+                "--inputs-extrapolate {}: not a choice\n  hint: error or hold",
+                self.extrapolate
+            )
+        })?;
+        model
+            .set_inputs_from_csv(path, interp, extrapolate)
+            .map(drop)
+            .map_err(|e| e.to_string())
+    }
 }
 
 /// `bg-sim run`.
@@ -73,7 +124,17 @@ pub fn command(a: Args) -> ExitCode {
         plots,
         plot_format,
         format,
+        inputs,
+        inputs_interp,
+        inputs_extrapolate,
+        no_breakpoints,
     } = a;
+    let drive = InputOptions {
+        data: inputs,
+        interp: inputs_interp,
+        extrapolate: inputs_extrapolate,
+        no_breakpoints,
+    };
     if format == Format::Json {
         crate::report::keep_stdout_for_document();
     }
@@ -88,6 +149,7 @@ pub fn command(a: Args) -> ExitCode {
         dt_out,
         &set,
         quiet,
+        &drive,
         &mut facts,
     );
     if format == Format::Json {
@@ -119,6 +181,7 @@ fn run(
     dt_out: Option<f64>,
     set: &[String],
     quiet: bool,
+    drive: &InputOptions,
     facts: &mut Facts,
 ) -> (ExitCode, Option<PathBuf>) {
     let refuse = |facts: &mut Facts, m: String| {
@@ -157,6 +220,9 @@ fn run(
     }
     if let Err(e) = model.settings.validate() {
         return refuse(facts, e.to_string());
+    }
+    if let Err(m) = drive.apply(&mut model) {
+        return refuse(facts, m);
     }
     let out_path = output.unwrap_or_else(|| {
         let stem = path

@@ -127,9 +127,25 @@ fn build(p: &dyn Params) -> Result<Box<dyn Element>, BuildError> {
         (true, false) => p.modulated("c")?,
         (false, true) => match p.modulated("k")? {
             Param::Const(k) => Param::Const(1.0 / k),
-            Param::Modulated { inputs, law } => {
-                Param::modulated(inputs, move |t, u| 1.0 / law(t, u))
-            }
+            Param::Modulated {
+                inputs,
+                law,
+                gradient: None,
+            } => Param::modulated(inputs, move |t, u| 1.0 / law(t, u)),
+            // c = 1/k: ∂c/∂u = −(∂k/∂u)/k²
+            Param::Modulated {
+                inputs,
+                law,
+                gradient: Some(grad),
+            } => Param::modulated_exact(
+                inputs,
+                move |t, u| 1.0 / law(t, u),
+                move |t, u, g| {
+                    let k = grad(t, u, g);
+                    g.iter_mut().for_each(|d| *d = -*d / (k * k));
+                    1.0 / k
+                },
+            ),
         },
         (true, true) => {
             return Err(BuildError::conflict(

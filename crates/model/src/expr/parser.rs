@@ -29,6 +29,8 @@ fn check_clamp(name: &str, args: &[Expr], start: usize) -> Result<(), ExprError>
 
 pub(super) struct Parser<'a> {
     c: &'a [char],
+    /// Lookup tables callable as functions: name and number of arguments.
+    tables: &'a [(String, usize)],
     i: usize,
     /// Current recursion depth of the parser.
     nest: usize,
@@ -39,9 +41,13 @@ type Parsed = (Expr, usize);
 
 impl<'a> Parser<'a> {
     /// All of `chars` as one expression.
-    pub(super) fn whole(chars: &'a [char]) -> Result<Expr, ExprError> {
+    pub(super) fn whole(
+        chars: &'a [char],
+        tables: &'a [(String, usize)],
+    ) -> Result<Expr, ExprError> {
         let mut p = Parser {
             c: chars,
+            tables,
             i: 0,
             nest: 0,
         };
@@ -207,8 +213,15 @@ impl<'a> Parser<'a> {
             });
         }
         if self.peek() == Some('(') {
-            let Some(&(_, arity)) = FUNCTIONS.iter().find(|(f, _)| *f == name) else {
-                let known: Vec<&str> = FUNCTIONS.iter().map(|(f, _)| *f).collect();
+            let table = self
+                .tables
+                .iter()
+                .find(|(t, _)| *t == name)
+                .map(|(_, n)| Some(*n));
+            let builtin = FUNCTIONS.iter().find(|(f, _)| *f == name).map(|(_, a)| *a);
+            let Some(arity) = table.or(builtin) else {
+                let mut known: Vec<&str> = FUNCTIONS.iter().map(|(f, _)| *f).collect();
+                known.extend(self.tables.iter().map(|(t, _)| t.as_str()));
                 return Err(ExprError {
                     pos: start,
                     message: format!(

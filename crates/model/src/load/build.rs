@@ -84,7 +84,8 @@ impl Source {
             .get(&def.kind)
             .ok_or_else(|| self.unknown_kind(def))?;
         let used = RefCell::new(HashSet::new());
-        let spec = ElementSpec::new(
+        let input_names = self.input_names();
+        let mut spec = ElementSpec::new(
             &def.name,
             &def.kind,
             info.params,
@@ -95,6 +96,8 @@ impl Source {
             def.name_span.clone(),
             &used,
         );
+        spec.inputs = &input_names;
+        spec.tables = std::sync::Arc::clone(&self.tables);
         spec.validate().map_err(|e| spec.locate(e))?;
         let built = match info.build {
             bondgraph::kind::Build::Element(f) => Built::One(f(&spec).map_err(|e| spec.locate(e))?),
@@ -175,6 +178,19 @@ pub(super) fn build_elements(
     g: &mut BondGraph,
 ) -> Vec<(usize, (String, String, String))> {
     let mut internal = Vec::new();
+    for (name, el) in super::inputs::elements(&p.source.inputs, &p.source) {
+        let added = el.and_then(|el| {
+            g.add(&name, el).map(drop).map_err(|e| {
+                p.source
+                    .err(ErrorKind::Input, None, e.message())
+                    .or_hint(e.hint())
+                    .element(&name)
+            })
+        });
+        if let Err(e) = added {
+            p.problems.push(e);
+        }
+    }
     for i in 0..p.source.elements.len() {
         let def = &p.source.elements[i];
         let m = match p.source.build_members(def, &p.parameters) {

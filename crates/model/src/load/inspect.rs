@@ -30,6 +30,9 @@ pub struct Inspection {
     pub notes: Vec<ModelError>,
     /// The scene switches (`[scene]`).
     pub scene: Scene,
+    /// The external inputs (`[inputs]`), each with where its data come from (`""`: its
+    /// default, unless a run gives data).
+    pub inputs: Vec<(bondgraph::InputSpec, String)>,
 }
 
 /// Read a model file for `bg-sim check`: elements, bonds with causality, states, and every
@@ -52,6 +55,17 @@ pub fn inspect(path: &Path, registry: &Registry, overrides: &[String]) -> Inspec
             return out;
         }
     };
+    out.inputs = p
+        .source
+        .inputs
+        .iter()
+        .map(|d| {
+            let from = d.data.as_ref().map_or_else(String::new, |r| {
+                format!("{}, column {} ({})", r.file, r.column, r.interp.name())
+            });
+            (d.spec.clone(), from)
+        })
+        .collect();
     let g = build_graph(&mut p);
     out.elements = (0..g.n_elements())
         .map(|i| {

@@ -69,6 +69,9 @@ pub(super) fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, Vec<Mo
     let steady_spec = initial::apply(&spec.initial, &source, &parameters, &mut eqs, &mut problems);
     let sim = spec.simulation.unwrap_or_default();
     let settings = settings::read(&sim, &source, &mut problems);
+    if problems.is_empty() {
+        super::inputs::apply_files(&source, &eqs, &settings, &mut problems);
+    }
     let steady = match steady_spec {
         Some(v) if problems.is_empty() => {
             initial::steady(v, &source, &parameters, &settings, &mut eqs).unwrap_or_else(|e| {

@@ -41,6 +41,12 @@ pub(super) struct FileSpec {
     pub(super) check: Vec<Spanned<CheckSpec>>,
     #[serde(default)]
     pub(super) scene: SpannedMap<toml::Value>,
+    /// `[inputs]`: read by `super::inputs`.
+    #[serde(default)]
+    pub(super) inputs: SpannedMap<toml::Value>,
+    /// `[tables]`: read by `super::tables`.
+    #[serde(default)]
+    pub(super) tables: SpannedMap<toml::Value>,
     /// `[[plot]]`: read by `crate::plots`.
     #[serde(default, rename = "plot")]
     pub(super) _plot: serde::de::IgnoredAny,
@@ -115,7 +121,7 @@ fn syntax(file: &str, text: &str, e: &toml::de::Error) -> ModelError {
     }
     ModelError::new(ErrorKind::Syntax, file, message)
         .at(pos)
-        .hint("a model has the sections title, description, [parameters], [elements], [bonds], [simulation], [initial], [[events]], [outputs], [[check]], [scene], [[plot]]")
+        .hint("a model has the sections title, description, [parameters], [elements], [bonds], [simulation], [initial], [[events]], [outputs], [[check]], [scene], [[plot]], [inputs], [tables]")
 }
 
 /// The lines (1-based) of `after` that differ from those of `before`.
@@ -222,6 +228,8 @@ pub(super) fn parse(
         events: Vec::new(),
         changed_lines,
         plots: Vec::new(),
+        inputs: Vec::new(),
+        tables: std::sync::Arc::default(),
     };
     let mut problems = Vec::new();
     let mut failed = Failed::default();
@@ -251,6 +259,8 @@ pub(super) fn parse(
             }
         }
     }
+    source.inputs = super::inputs::read(&spec.inputs, &source, &parameters, &mut problems);
+    source.tables = std::sync::Arc::new(super::tables::read(&spec.tables, &source, &mut problems));
     for ev in &spec.events {
         let set = ev
             .get_ref()

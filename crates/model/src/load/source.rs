@@ -46,6 +46,10 @@ pub(super) struct Source {
     pub(super) changed_lines: Vec<usize>,
     /// The `[[plot]]` tables (`crate::plots`).
     pub(super) plots: Vec<crate::plots::Plot>,
+    /// The `[inputs]` entries (`super::inputs`).
+    pub(super) inputs: Vec<super::inputs::InputDef>,
+    /// The `[tables]` (`super::tables`), shared by every expression that calls one.
+    pub(super) tables: std::sync::Arc<crate::tables::Tables>,
 }
 
 impl Source {
@@ -61,12 +65,24 @@ impl Source {
         mark_set_line(e, &self.changed_lines)
     }
 
-    /// Line and column of the entry that defines element `name` (or a member of it).
+    /// Line and column of the entry that defines element `name` (or a member of it, or
+    /// the `[inputs]` entry of that name).
     pub(super) fn element_pos(&self, name: &str) -> Option<(usize, usize)> {
         self.elements
             .iter()
             .find(|e| e.name == name || e.members.iter().any(|m| m == name))
             .map(|e| line_col(&self.text, e.name_span.start))
+            .or_else(|| {
+                self.inputs
+                    .iter()
+                    .find(|d| d.spec.name == name)
+                    .map(|d| line_col(&self.text, d.span.start))
+            })
+    }
+
+    /// The names of the `[inputs]`.
+    pub(super) fn input_names(&self) -> Vec<String> {
+        self.inputs.iter().map(|d| d.spec.name.clone()).collect()
     }
 }
 

@@ -48,7 +48,17 @@ impl Params for ElementSpec<'_> {
         if let Some(c) = compiled.constant() {
             return self.in_range(d, c).map(Param::Const);
         }
-        Ok(Param::modulated(inputs, move |_, u| compiled.eval(u)))
+        if !compiled.has_exact_gradient() {
+            return Ok(Param::modulated(inputs, move |_, u| compiled.eval(u)));
+        }
+        // the exact gradient of the expression (forward mode): tables' slopes included
+        let c = std::sync::Arc::new(compiled);
+        let g = std::sync::Arc::clone(&c);
+        Ok(Param::modulated_exact(
+            inputs,
+            move |_, u| c.eval(u),
+            move |_, u, grad| g.eval_grad(u, grad),
+        ))
     }
     fn count(&self, key: &str) -> Result<usize, BuildError> {
         let v = self.number(key)?;
@@ -191,7 +201,7 @@ impl Params for ElementSpec<'_> {
         for e in &exprs {
             self.note_constants(e);
             let c = e
-                .compile(&|n| self.constants.get(n).copied(), &inputs)
+                .compile_with(&|n| self.constants.get(n).copied(), &inputs, &self.tables)
                 .map_err(|m| self.err(BuildErrorKind::Invalid, key, m))?;
             entries.push(Box::new(move |u| c.eval(u)));
         }
