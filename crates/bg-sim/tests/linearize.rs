@@ -133,3 +133,59 @@ fn free_mass_spring_damper_poles() {
         assert_eq!(lin["C"], serde_json::json!([[0.0, 1.0], [1.0, 0.0]]));
     }
 }
+
+/// models/msd_force.toml (m = 1, k = 100, c = 2, force input F, output x): poles
+/// −1 ± 9.95i (√99 = 9.9499), DC gain 0.01, B = [1, 0]ᵀ, D = 0; the Bode data's magnitude
+/// equals 1/|k − mω² + jcω| and a PNG is drawn.
+#[test]
+fn msd_force_input_poles_dc_gain_and_bode() {
+    let lin = json(&[
+        "linearize",
+        "models/msd_force.toml",
+        "--inputs",
+        "F",
+        "--outputs",
+        "x",
+        "--format",
+        "json",
+    ]);
+    let wd = 99f64.sqrt();
+    let poles = lin["poles"].as_array().unwrap();
+    assert_eq!(poles.len(), 2);
+    for p in poles {
+        let (re, im) = (p["re"].as_f64().unwrap(), p["im"].as_f64().unwrap());
+        assert!((re + 1.0).abs() < 1e-12 && (im.abs() - wd).abs() < 1e-12, "{p}");
+    }
+    assert!(format!("{wd:.2}") == "9.95");
+    let dc = lin["dc_gain"][0][0].as_f64().unwrap();
+    assert!((dc - 0.01).abs() < 1e-15, "{dc}");
+    assert_eq!(lin["states"], serde_json::json!(["mass.p", "spring.q"]));
+    assert_eq!(lin["B"], serde_json::json!([[1.0], [0.0]]));
+    assert_eq!(lin["D"], serde_json::json!([[0.0]]));
+
+    let dir = std::env::temp_dir().join(format!("bg-sim-linearize-{}", std::process::id()));
+    let png = dir.join("bode.png");
+    let out = bg_sim()
+        .current_dir(root())
+        .args(["linearize", "models/msd_force.toml", "--bode", "F:x", "--freq", "0.1..100"])
+        .args(["--points", "50", "--format", "csv", "--plot"])
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8(out.stdout).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("f_hz,magnitude,db,phase_deg"));
+    let mut n = 0;
+    for l in lines {
+        let v: Vec<f64> = l.split(',').map(|s| s.parse().unwrap()).collect();
+        let w = 2.0 * std::f64::consts::PI * v[0];
+        let want = 1.0 / (100.0 - w * w).hypot(2.0 * w);
+        assert!((v[1] / want - 1.0).abs() < 1e-12, "{l}");
+        assert!(v[3] <= 0.0 && v[3] >= -180.0, "{l}");
+        n += 1;
+    }
+    assert_eq!(n, 50);
+    assert!(std::fs::metadata(&png).unwrap().len() > 10_000);
+    let _ = std::fs::remove_dir_all(&dir);
+}
