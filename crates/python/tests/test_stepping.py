@@ -92,3 +92,57 @@ def test_linearize_returns_named_numpy_matrices():
     np.testing.assert_allclose(sim.linearize(outputs=["x"]).A, A, atol=1e-12)
     with pytest.raises(bgsim.BgSimError, match="did you mean"):
         model.linearize(outputs=["xx"])
+
+
+MSD_F = MODELS / "msd_force.toml"
+
+
+def test_set_inputs_drives_the_force_input():
+    sim = bgsim.load(MSD_F).start()
+    assert sim.inputs == ["F"]
+    sim.advance_to(1.0)
+    assert sim.get("x") == 0.0
+    sim.set_inputs(F=10.0)
+    sim.set_inputs({"F": 10.0})  # the same value again: nothing happens
+    jac_before = sim.stats()["jac_evals"]
+    for k in range(1, 1901):
+        sim.advance_to(1.0 + k * 0.01)
+    assert sim.get("F") == 10.0
+    assert abs(sim.get("x") - 0.1) < 1e-6
+    # no restart per call: far fewer Jacobians than calls
+    assert sim.stats()["jac_evals"] - jac_before < 50, sim.stats()
+
+
+def test_run_with_a_dataframe_or_numpy_input_equals_the_step_in_the_model():
+    import pandas as pd
+
+    model = bgsim.load(MSD_F)
+    ref = bgsim.load(MSD_F, set={"F_step": 10.0}).run(t_end=5.0)
+    data = pd.DataFrame({"t": [0.0, 1.0, 5.0], "F": [0.0, 10.0, 10.0]})
+    df = model.run(t_end=5.0, inputs=data, inputs_interp="hold")
+    assert np.abs(df["x"].to_numpy() - ref["x"].to_numpy()).max() < 1e-9
+    arrays = model.run(
+        t_end=5.0, inputs={"F": (np.array([0.0, 1.0, 5.0]), np.array([0.0, 10.0, 10.0]))}, inputs_interp="hold"
+    )
+    assert np.abs(arrays["x"].to_numpy() - ref["x"].to_numpy()).max() < 1e-9
+    with pytest.raises(bgsim.BgSimError, match="end at t = 2"):
+        model.run(t_end=5.0, inputs={"F": ([0.0, 2.0], [0.0, 1.0])})
+    held = model.run(t_end=5.0, inputs={"F": ([0.0, 2.0], [0.0, 1.0])}, extrapolate="hold")
+    assert held["F"].iloc[-1] == 1.0
+    with pytest.raises(bgsim.BgSimError, match="did you mean `F`"):
+        model.run(t_end=5.0, inputs={"f": ([0.0, 5.0], [0.0, 1.0])})
+
+
+def test_linearize_the_force_input():
+    model = bgsim.load(MSD_F)
+    A, B, C, D = model.linearize(t=0.0, inputs=["F"], outputs=["x"])
+    lin = model.linearize(t=0.0, inputs=["F"], outputs=["x"])
+    np.testing.assert_array_equal(B, [[1.0], [0.0]])
+    np.testing.assert_array_equal(D, [[0.0]])
+    assert lin.inputs == ["F"] and lin.outputs == ["x"]
+    assert lin.dc_gain("F", "x") == pytest.approx(0.01, abs=1e-15)
+    poles = np.sort_complex(lin.poles())
+    np.testing.assert_allclose(poles, [-1 - math.sqrt(99) * 1j, -1 + math.sqrt(99) * 1j], atol=1e-12)
+    w = 2 * np.pi * np.array([0.1, 1.0, 10.0])
+    g = lin.response("F", "x", w / (2 * np.pi))
+    np.testing.assert_allclose(g, 1 / (100 - w**2 + 2j * w), rtol=1e-12)
