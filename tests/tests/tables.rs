@@ -2,7 +2,7 @@
 //! carries the tables' exact slopes (covered for every model by tests/jacobian.rs; here the
 //! valve's resistance against a hand-written derivative), and bad tables and inputs are
 //! clean errors at their line naming the table or input and the entry.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
 
 use bg_model::{ErrorKind, Model};
 use bondgraph::DMatrix;

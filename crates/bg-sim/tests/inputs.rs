@@ -1,7 +1,7 @@
 //! `bg-sim run --inputs`: the mass–spring–damper driven by a CSV step of 10 N ends at the
 //! static deflection and matches the same step written in the model; bad data are clean
 //! errors (file, line, column, hint) with exit status 2; `check` lists the inputs.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -34,6 +34,14 @@
 //! Other crates add kinds by implementing [`Element`]; modulation goes through named signals
 //! ([`Param`], [`Element::signal_inputs`]).
 //!
+//! ## External inputs
+//! An [`Input`] element is a signal set from outside the model (a force, a valve command,
+//! recorded data): its value is published under its bare name, held or following a
+//! [`Series`] (linear or hold). [`StateEquations`] lists the inputs and sets them by index or
+//! name (`inputs`, `set_input`, `set_input_by_name`, `set_input_series`,
+//! `input_breakpoints`, `input_signal_offset` for derivatives with respect to an input);
+//! [`simulate()`] stops and restarts at the series' breakpoints unless told not to.
+//!
 //! ## Element kinds
 //! [`kind`] declares what a model file may write for each element kind: its parameters as data
 //! ([`ParamDecl`]: name, unit, default, range, description), its builder reading them through

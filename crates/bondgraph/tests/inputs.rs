@@ -1,6 +1,6 @@
 //! External inputs ([`Input`]) through the library API: listed, set by index and name,
 //! following a series whose corners the run stops on, read as a column.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
 
 mod common;
 

@@ -183,10 +183,10 @@ impl DataFile {
         let t = &self.columns[k];
         for i in 1..t.len() {
             if t[i] <= t[i - 1] {
-                let what = if t[i] == t[i - 1] {
-                    "repeats"
-                } else {
+                let what = if t[i] < t[i - 1] {
                     "is before"
+                } else {
+                    "repeats"
                 };
                 return Err(err(
                     &self.file,

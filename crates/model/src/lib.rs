@@ -36,6 +36,10 @@
 //! [`structure`] stops at the graph and its causality (`bg-sim graph`). Every problem is a
 //! [`ModelError`] ([`error`]): file, line, column, element, message, hint, source.
 //!
+//! External inputs and data: `[inputs]` (signals set from outside, [`Model::inputs`],
+//! [`Model::set_inputs_from_csv`]), [`data`] (CSV files with line/column errors), [`tables`]
+//! (`[tables]`: 1-D and 2-D lookup tables called like functions, with exact derivatives).
+//!
 //! Around a model: [`scene`] (switches between richer and cheaper scenes), [`plots`]
 //! (`[[plot]]` tables), [`describe`] (a kind's parameters, for `bg-sim kinds`).
 //!

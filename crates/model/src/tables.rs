@@ -362,7 +362,7 @@ impl Tables {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(clippy::unwrap_used, clippy::float_cmp)]
     use super::*;
 
     fn check_derivatives(t: &Table, points: &[[f64; 2]]) {

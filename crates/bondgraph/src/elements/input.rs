@@ -346,7 +346,7 @@ impl Element for Input {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(clippy::unwrap_used, clippy::float_cmp)]
     use super::*;
 
     fn spec() -> InputSpec {
