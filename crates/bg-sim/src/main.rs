@@ -12,7 +12,9 @@ mod commands;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use commands::{bench, check, compare, graph, kinds, modes, plot, reduce, run, sweep, FAILED};
+use commands::{
+    bench, check, compare, graph, kinds, linearize, modes, plot, reduce, run, sweep, FAILED,
+};
 
 #[derive(Parser)]
 #[command(
@@ -48,6 +50,10 @@ enum Command {
     /// list every eigenvalue as frequency, damping ratio and time constant with the states
     /// that take part in it, the stiffness ratio and what it means for the solver.
     Modes(modes::Args),
+    /// The linear model (A, B, C, D, exact) for named inputs and outputs at the initial state
+    /// or at time T of a run, its poles and DC gains; with --bode IN:OUT the frequency
+    /// response of one pair (CSV/JSON data, a PNG figure with --plot).
+    Linearize(linearize::Args),
     /// Measure the speed–accuracy trade: every solver at every rtol against a reference
     /// (wall time, steps, rhs evaluations, the worst scaled error of the scored columns).
     Bench(bench::Args),
@@ -71,6 +77,7 @@ fn main() -> ExitCode {
             | Command::Check { .. }
             | Command::Compare { .. }
             | Command::Modes { .. }
+            | Command::Linearize { .. }
     );
     let code = dispatch(cli.command);
     let lost = report::STDOUT_ERROR.lock().ok().and_then(|e| *e);
@@ -97,6 +104,7 @@ fn dispatch(command: Command) -> ExitCode {
         Command::Graph(a) => graph::command(a),
         Command::Kinds(a) => kinds::command(&a),
         Command::Modes(a) => modes::command(&a),
+        Command::Linearize(a) => linearize::command(&a),
         Command::Bench(a) => bench::command(a),
         Command::Reduce(a) => reduce::command(a),
         Command::Compare(a) => compare::command(&a),

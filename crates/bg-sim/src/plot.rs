@@ -9,6 +9,7 @@
 //! pale band. Text is set in DejaVu Sans, which the `dejavu` crate ships: no system fonts
 //! are needed.
 
+mod bode;
 mod contour;
 mod figure;
 mod quick;
@@ -21,6 +22,7 @@ use std::sync::OnceLock;
 use plotters::prelude::*;
 use plotters::style::register_font;
 
+pub use bode::bode;
 pub use contour::{contour, Map};
 pub use figure::{draw, draw_all};
 pub use quick::quick_look;

@@ -61,6 +61,9 @@
 //! states held at values) by Newton's method with the exact Jacobian ([`equilibrium`]).
 //! [`modes`](fn@modes) linearises at a state and lists every eigenvalue as frequency, damping ratio and
 //! time constant with the participation of each state ([`modes`](mod@modes) module).
+//! [`linearize`](fn@linearize) gives the linear model (A, B, C, D) at an operating point, all
+//! four exact, with poles, frequency response and Bode data ([`linearize`](mod@linearize)
+//! module).
 //!
 //! ## Simulation
 //! [`simulate()`] integrates with every [`Method`] behind one solver interface — our Radau IIA
@@ -68,7 +71,8 @@
 //! Jacobian ([`StateEquations::jacobian`]), output times, scheduled [`Event`]s, limits and
 //! [`Statistics`], and keeps the rows computed when it fails. [`radau`] is the standalone
 //! Radau IIA integrator: [`Radau5`] over an [`OdeSystem`], stepped towards stop times, with
-//! dense output and restarts.
+//! dense output and restarts. [`Simulation`] is a run advanced call by call (a controller
+//! outside the model), keeping the solver's state between calls.
 
 pub mod bond;
 pub mod causality;
@@ -81,6 +85,7 @@ pub mod graph;
 pub mod io;
 pub mod kind;
 pub mod kinds;
+pub mod linearize;
 pub mod local_jacobian;
 pub mod modes;
 pub mod partials_check;
@@ -100,6 +105,7 @@ pub use equilibrium::{solve_steady, Condition, Equilibrium, EquilibriumError, St
 pub use error::{CausalityError, Error, GraphError, ParamError, SimulationError};
 pub use graph::{BondGraph, Node};
 pub use kind::{BuildError, Composite, KindDecl, ParamDecl, Params};
+pub use linearize::{linearize, BodePoint, Linearization};
 pub use local_jacobian::{LocalJacobian, LocalShape};
 pub use modes::{modes, modes_of, stiffness_ratio, Mode, ModesError};
 /// The dense matrix type of [`StateEquations::jacobian`].
@@ -108,5 +114,6 @@ pub use partials_check::check_partials;
 pub use radau::{OdeSystem, Radau5, RadauError, RadauOptions, RadauStats, StepReport};
 pub use simulate::{
     check_in_memory, simulate, simulate_into, Event, Method, Outcome, Output, RowSink, Settings,
-    Statistics, Trajectory, WatchReport, MAX_OUTPUT_ROWS, MAX_VALUES_IN_MEMORY, MIN_RTOL,
+    Simulation, Statistics, Trajectory, WatchReport, MAX_OUTPUT_ROWS, MAX_VALUES_IN_MEMORY,
+    MIN_RTOL,
 };

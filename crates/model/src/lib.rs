@@ -71,7 +71,7 @@ pub use describe::{describe, parameter_table, KindReport};
 pub use error::{ErrorKind, ModelError};
 pub use load::{
     inspect, solver, structure, Check, CheckResult, Entry, Extrapolate, Inspection, Model,
-    Structure, UnknownSolver,
+    Stepping, Structure, UnknownSolver,
 };
 pub use plots::{Panel, Plot, Series};
 pub use reader::{ElementSpec, RawValue};

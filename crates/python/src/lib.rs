@@ -6,6 +6,8 @@
 //! `Model` holds `RefCell`s and cannot cross threads, while a path and a list of strings
 //! pickle, so the same calls run on Dask workers. Loading costs milliseconds.
 
+mod stepping;
+
 use std::path::{Path, PathBuf};
 
 use bg_model::{Model, ModelError};
@@ -113,7 +115,7 @@ type RunResult<'py> = (
 
 /// Run a model: (columns, row-major f64 values as bytes, statistics, error or None).
 #[pyfunction]
-#[pyo3(signature = (path, set, t_end=None, rtol=None, atol=None, dt_out=None, solver=None))]
+#[pyo3(signature = (path, set, t_end=None, rtol=None, atol=None, dt_out=None, solver=None, inputs=Vec::new(), extrapolate=false))]
 #[allow(clippy::too_many_arguments)]
 fn run<'py>(
     py: Python<'py>,
@@ -124,12 +126,16 @@ fn run<'py>(
     atol: Option<f64>,
     dt_out: Option<f64>,
     solver: Option<String>,
+    inputs: Vec<stepping::InputData>,
+    extrapolate: bool,
 ) -> PyResult<RunResult<'py>> {
     let all = settings(&set, t_end, rtol, atol, dt_out, solver.as_deref());
     // the GIL is released while the model runs: other Python threads go on
-    let result = py.detach(move || -> Result<_, ModelError> {
-        let mut m = Model::load(&path, &bg_sim::registry(), &all)?;
-        let (out, checks) = m.run_checked()?;
+    let result = py.detach(move || -> Result<_, Result<ModelError, String>> {
+        let mut m = Model::load(&path, &bg_sim::registry(), &all).map_err(Ok)?;
+        let span = Some((m.settings.t_start, m.settings.t_end));
+        stepping::set_series(&mut m, inputs, span, extrapolate).map_err(Err)?;
+        let (out, checks) = m.run_checked().map_err(Ok)?;
         let failed: Vec<String> = checks
             .iter()
             .filter(|c| !c.passed)
@@ -142,7 +148,10 @@ fn run<'py>(
             .collect();
         Ok((out, failed))
     });
-    let (out, failed) = result.map_err(|e| model_error(py, &e))?;
+    let (out, failed) = result.map_err(|e| match e {
+        Ok(e) => model_error(py, &e),
+        Err(message) => other_error(message),
+    })?;
     let mut bytes =
         Vec::with_capacity(8 * out.trajectory.rows.len() * out.trajectory.columns.len());
     for r in &out.trajectory.rows {
@@ -299,6 +308,8 @@ fn sweep<'py>(
 /// Bond-graph model files from Python (the compiled half of `bgsim`).
 #[pymodule]
 mod _bgsim {
+    #[pymodule_export]
+    use super::stepping::{linearize, start, Sim};
     #[pymodule_export]
     use super::{describe, run, run_one, spec_metrics, spec_points, sweep, BgSimError};
 }

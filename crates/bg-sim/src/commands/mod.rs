@@ -11,6 +11,7 @@ pub mod compare;
 pub mod graph;
 pub mod json;
 pub mod kinds;
+pub mod linearize;
 pub mod modes;
 pub mod plot;
 pub mod reduce;

@@ -23,6 +23,8 @@ use crate::local_jacobian::{LocalJacobian, LocalShape, Touched};
 
 use super::StateEquations;
 
+mod outputs;
+
 /// How a scalar depends on the state vector x.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) enum Dep {

@@ -29,6 +29,9 @@
 mod radau;
 mod segment;
 mod stepper;
+mod stepping;
+
+pub use stepping::Simulation;
 
 use segment::run_segment;
 

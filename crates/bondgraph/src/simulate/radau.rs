@@ -11,11 +11,11 @@ use crate::radau::{OdeSystem, Radau5, RadauOptions};
 
 /// The equations as the Radau integrator sees them: calls counted, the first non-finite
 /// derivative noted for the error report.
-struct RadauEquations<'e> {
-    eqs: &'e StateEquations,
-    bad: &'e RefCell<Option<(f64, Vec<f64>)>>,
-    rhs_calls: usize,
-    jac_calls: usize,
+pub(super) struct RadauEquations<'e> {
+    pub(super) eqs: &'e StateEquations,
+    pub(super) bad: &'e RefCell<Option<(f64, Vec<f64>)>>,
+    pub(super) rhs_calls: usize,
+    pub(super) jac_calls: usize,
 }
 
 impl OdeSystem for RadauEquations<'_> {
@@ -54,11 +54,11 @@ impl OdeSystem for RadauEquations<'_> {
 
 /// [`Radau5`] as a [`Stepper`]: limits are located inside each step by bisection on the
 /// dense output.
-struct RadauStepper<'e> {
-    radau: Radau5,
-    sys: RadauEquations<'e>,
-    t_stop: f64,
-    limits: &'e [Bound],
+pub(super) struct RadauStepper<'e> {
+    pub(super) radau: Radau5,
+    pub(super) sys: RadauEquations<'e>,
+    pub(super) t_stop: f64,
+    pub(super) limits: &'e [Bound],
 }
 
 impl RadauStepper<'_> {
@@ -145,7 +145,7 @@ impl Stepper for RadauStepper<'_> {
 /// Newton convergence rate above which Radau5 evaluates a new Jacobian for the next step.
 /// RADAU5's 0.001 renews it almost every step on the crane; at 0.03 the Jacobians fall by
 /// 2.2× for 2 % more steps (docs/performance.md).
-const RADAU_JACOBIAN_THETA: f64 = 0.03;
+pub(super) const RADAU_JACOBIAN_THETA: f64 = 0.03;
 
 #[allow(clippy::too_many_arguments)]
 pub(super) fn run_radau(

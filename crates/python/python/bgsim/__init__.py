@@ -4,6 +4,9 @@
     >>> model = bgsim.load("models/mass_spring_damper.toml", set={"k": 20.0})
     >>> df = model.run(t_end=2.0)            # a pandas DataFrame: t, then the [outputs]
     >>> summary = bgsim.sweep("models/mass_spring_damper.toml", "sweep.toml")
+    >>> sim = model.start()                  # advanced call by call, the solver kept warm
+    >>> sim.advance_to(0.5); sim.get("x")
+    >>> lin = model.linearize(outputs=["x"])  # A, B, C, D as numpy arrays, with names
 
 A model is named by its file and its overrides (``set``: the ``--set`` values of the
 command line; a bare name is a parameter, ``"simulation.rtol"`` any other value), and is
@@ -23,7 +26,17 @@ import pandas as pd
 from . import _bgsim
 from ._bgsim import BgSimError
 
-__all__ = ["BgSimError", "Model", "RunError", "load", "sweep", "sweep_points", "dask_sweep"]
+__all__ = [
+    "BgSimError",
+    "LinearModel",
+    "Model",
+    "RunError",
+    "Simulation",
+    "load",
+    "sweep",
+    "sweep_points",
+    "dask_sweep",
+]
 
 PathLike = Union[str, "os.PathLike[str]"]
 Scalar = Union[float, int, str]
@@ -50,6 +63,171 @@ def _overrides(set: Optional[Mapping[str, Scalar]]) -> List[str]:
             text = repr(float(value))
         out.append(f"{path}={text}")
     return out
+
+
+InputData = Union[pd.DataFrame, Mapping[str, Any]]
+
+
+def _input_data(inputs: Optional[InputData], interp: str) -> List[tuple]:
+    """Input data as (name, times, values, interp) tuples.
+
+    ``inputs`` is a DataFrame with a ``t`` column (or a time index named ``t``) and one
+    column per input, or a dict mapping an input's name to a pandas Series indexed by time
+    or to a ``(times, values)`` pair of array-likes (numpy arrays, lists).
+    """
+    if inputs is None:
+        return []
+    out = []
+    if isinstance(inputs, pd.DataFrame):
+        if "t" in inputs.columns:
+            t = inputs["t"].to_numpy(dtype=np.float64)
+            cols = [c for c in inputs.columns if c != "t"]
+        elif inputs.index.name == "t":
+            t = inputs.index.to_numpy(dtype=np.float64)
+            cols = list(inputs.columns)
+        else:
+            raise BgSimError("input data: the DataFrame needs a `t` column (or an index named `t`)")
+        for c in cols:
+            out.append((str(c), t.tolist(), inputs[c].to_numpy(dtype=np.float64).tolist(), interp))
+        return out
+    for name, data in dict(inputs).items():
+        if isinstance(data, pd.Series):
+            t, v = data.index.to_numpy(dtype=np.float64), data.to_numpy(dtype=np.float64)
+        else:
+            try:
+                t, v = data
+            except (TypeError, ValueError):
+                raise BgSimError(
+                    f"input data `{name}`: expected a pandas Series indexed by time or a (times, values) pair"
+                ) from None
+            t, v = np.asarray(t, dtype=np.float64), np.asarray(v, dtype=np.float64)
+        if t.ndim != 1 or v.ndim != 1:
+            raise BgSimError(f"input data `{name}`: times and values must be one-dimensional")
+        out.append((str(name), t.tolist(), v.tolist(), interp))
+    return out
+
+
+class LinearModel:
+    """The model linearised at one point: ``dδx/dt = A δx + B δu``, ``δy = C δx + D δu``.
+
+    ``A, B, C, D`` are numpy arrays; ``states``, ``inputs`` and ``outputs`` name their rows
+    and columns; ``t`` and ``x`` are the operating point. All four are exact (the model's
+    own Jacobian, carried through the inputs and outputs).
+    """
+
+    def __init__(self, d: Mapping[str, Any]):
+        self.t: float = d["t"]
+        self.x = np.asarray(d["x"], dtype=np.float64)
+        self.states: List[str] = list(d["states"])
+        self.inputs: List[str] = list(d["inputs"])
+        self.outputs: List[str] = list(d["outputs"])
+        n, m, p = len(self.states), len(self.inputs), len(self.outputs)
+        self.A = np.asarray(d["A"], dtype=np.float64).reshape(n, n)
+        self.B = np.asarray(d["B"], dtype=np.float64).reshape(n, m)
+        self.C = np.asarray(d["C"], dtype=np.float64).reshape(p, n)
+        self.D = np.asarray(d["D"], dtype=np.float64).reshape(p, m)
+
+    def __iter__(self):
+        return iter((self.A, self.B, self.C, self.D))
+
+    def __repr__(self) -> str:
+        return (
+            f"LinearModel(t={self.t}, {len(self.states)} states, inputs={self.inputs}, "
+            f"outputs={self.outputs})"
+        )
+
+    def poles(self) -> np.ndarray:
+        """The eigenvalues of A (1/s)."""
+        return np.linalg.eigvals(self.A)
+
+    def response(self, input: str, output: str, f_hz: Any) -> np.ndarray:
+        """G(j2πf) = C (j2πf I − A)⁻¹ B + D of one input–output pair, complex."""
+        i, o = self.inputs.index(input), self.outputs.index(output)
+        f = np.atleast_1d(np.asarray(f_hz, dtype=np.float64))
+        n = self.A.shape[0]
+        g = np.empty(f.shape, dtype=complex)
+        for k, fk in enumerate(f):
+            v = np.linalg.solve(2j * np.pi * fk * np.eye(n) - self.A, self.B[:, i])
+            g[k] = self.C[o] @ v + self.D[o, i]
+        return g
+
+    def dc_gain(self, input: str, output: str) -> float:
+        """G(0) = D − C A⁻¹ B of one pair."""
+        return float(self.response(input, output, 0.0)[0].real)
+
+
+class Simulation:
+    """A model advanced call by call; see :meth:`Model.start`.
+
+    The solver (Radau IIA) keeps its step size, Jacobian and LU between calls: a call
+    costs what the steps inside it cost, plus one short step landing on its end. Setting an
+    input to a new value costs one evaluation of the equations; the same value costs
+    nothing. Nothing is restarted unless a scheduled ``[[events]]`` entry replaces elements.
+    """
+
+    def __init__(self, sim: Any, model: "Model"):
+        self._sim = sim
+        self.model = model
+        #: The inputs' names.
+        self.inputs: List[str] = list(sim.input_names())
+        #: The ``[outputs]`` columns.
+        self.outputs: List[str] = list(sim.output_names())
+
+    def __repr__(self) -> str:
+        return f"bgsim.Simulation({self.model.path!r}, t={self.t})"
+
+    @property
+    def t(self) -> float:
+        """The current time (s)."""
+        return self._sim.t
+
+    def advance_to(self, t: float) -> "Simulation":
+        """Integrate on to time ``t`` (landing on it exactly). Raises :class:`BgSimError` if
+        ``t`` lies behind, or the run fails on the way (the simulation then stays failed)."""
+        self._sim.advance_to(float(t))
+        return self
+
+    def advance(self, dt: float) -> "Simulation":
+        """Integrate on by ``dt`` seconds."""
+        self._sim.advance(float(dt))
+        return self
+
+    def get(self, name: str) -> float:
+        """The value of an ``[outputs]`` column or any variable (``mass.p``, ``spring.e``,
+        an input's name) now."""
+        return self._sim.get(name)
+
+    def get_many(self, names: Sequence[str]) -> Dict[str, float]:
+        """Several values now, from one evaluation."""
+        return dict(zip(names, self._sim.get_many(list(names))))
+
+    def state(self) -> pd.Series:
+        """The state now, named (``mass.p``, ``spring.q``, …)."""
+        names, values = self._sim.state()
+        return pd.Series(values, index=names, dtype=np.float64, name=self.t)
+
+    def set_inputs(self, values: Optional[Mapping[str, Any]] = None, **kw: Any) -> "Simulation":
+        """Set inputs by name: a number holds the input at that value from now on; a pandas
+        Series indexed by time or a ``(times, values)`` pair makes it follow that data
+        (linear between samples; its sample times become stops). ``sim.set_inputs(F=10.0)``
+        or ``sim.set_inputs({"F": 10.0})``."""
+        all_values = {**dict(values or {}), **kw}
+        for name, v in all_values.items():
+            if isinstance(v, (int, float, np.floating, np.integer)):
+                self._sim.set_input(name, float(v))
+            else:
+                for n, t, vals, interp in _input_data({name: v}, "linear"):
+                    self._sim.set_input_series(n, t, vals, interp)
+        return self
+
+    def stats(self) -> Dict[str, Any]:
+        """Solver work since the start: steps, rhs_evals, jac_evals, lu_factorisations,
+        error_test_failures, newton_failures, events, wall_s (time spent advancing)."""
+        return dict(self._sim.stats())
+
+    def linearize(self, inputs: Sequence[str] = (), outputs: Sequence[str] = ()) -> LinearModel:
+        """The linear model at the current time and state (see :meth:`Model.linearize`)."""
+        return LinearModel(self._sim.linearize(list(inputs), list(outputs)))
 
 
 class Model:
@@ -85,16 +263,36 @@ class Model:
         dt_out: Optional[float] = None,
         solver: Optional[str] = None,
         as_dict: bool = False,
+        inputs: Optional[InputData] = None,
+        inputs_interp: str = "linear",
+        extrapolate: Optional[str] = None,
     ) -> Union[pd.DataFrame, Dict[str, np.ndarray]]:
         """Run the model and return its rows: a DataFrame (``t`` and the ``[outputs]``), or
         with ``as_dict=True`` a dict of numpy arrays.
 
-        Settings not given are the file's. The run's statistics are in ``df.attrs["stats"]``
-        (steps, rhs_evals, wall_s, failed_checks, …). A run that stops early raises
-        :class:`RunError`, which carries the rows computed so far.
+        Settings not given are the file's. ``inputs`` drives the model's inputs with data:
+        a DataFrame with a ``t`` column and one column per input (any subset; the others
+        keep their default), or a dict of name → pandas Series (indexed by time) or
+        ``(times, values)`` numpy arrays; linear between samples, or held with
+        ``inputs_interp="hold"``. The run stops and restarts at the samples' times. The data
+        must cover the run's span unless ``extrapolate="hold"``.
+
+        The run's statistics are in ``df.attrs["stats"]`` (steps, rhs_evals, wall_s,
+        failed_checks, …). A run that stops early raises :class:`RunError`, which carries
+        the rows computed so far.
         """
+        if extrapolate not in (None, "hold"):
+            raise BgSimError(f"extrapolate={extrapolate!r}: only \"hold\" (or None) is known")
         columns, data, stats, error = _bgsim.run(
-            self.path, _overrides(self.set), t_end, rtol, atol, dt_out, solver
+            self.path,
+            _overrides(self.set),
+            t_end,
+            rtol,
+            atol,
+            dt_out,
+            solver,
+            _input_data(inputs, inputs_interp),
+            extrapolate == "hold",
         )
         values = np.frombuffer(data, dtype=np.float64).reshape(-1, len(columns))
         if as_dict and error is None:
@@ -104,6 +302,44 @@ class Model:
         if error is not None:
             raise RunError(f"{self.path}: {error}", df, stats)
         return df
+
+    def start(
+        self,
+        t0: Optional[float] = None,
+        inputs: Optional[InputData] = None,
+        inputs_interp: str = "linear",
+    ) -> Simulation:
+        """Start the model at ``t0`` (its ``t_start`` if None) to be advanced call by call:
+        ``sim.set_inputs(F=10.0)``, ``sim.advance_to(t)`` / ``sim.advance(dt)``,
+        ``sim.get("x")``, ``sim.state()``, ``sim.t``. ``inputs`` gives inputs data from the
+        start (as for :meth:`run`). Each call to ``start`` loads the file anew."""
+        sim = _bgsim.start(
+            self.path,
+            _overrides(self.set),
+            None if t0 is None else float(t0),
+            _input_data(inputs, inputs_interp),
+        )
+        return Simulation(sim, self)
+
+    def linearize(
+        self,
+        t: Optional[float] = None,
+        inputs: Sequence[str] = (),
+        outputs: Sequence[str] = (),
+    ) -> LinearModel:
+        """The model linearised at its initial state (``t`` None or ``t_start``) or at time
+        ``t`` of a run: ``A, B, C, D = model.linearize(t=0.0, inputs=["F"], outputs=["x"])``
+        (numpy arrays; the result also has ``states``, ``inputs``, ``outputs``). Inputs are
+        names from the model's ``[inputs]``; outputs are ``[outputs]`` columns or any
+        variable. Exact, as ``bg-sim linearize``."""
+        d = _bgsim.linearize(
+            self.path,
+            _overrides(self.set),
+            None if t is None else float(t),
+            list(inputs),
+            list(outputs),
+        )
+        return LinearModel(d)
 
 
 def load(path: PathLike, set: Optional[Mapping[str, Scalar]] = None) -> Model:

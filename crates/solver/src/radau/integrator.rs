@@ -334,6 +334,17 @@ impl Radau5 {
         Ok(())
     }
 
+    /// The equations changed at the current time while the state did not jump (an input set
+    /// to a new value): f(t, y) is evaluated anew before the next step, and the Jacobian no
+    /// longer counts as current (a failed step renews it). The step size, the Jacobian and its
+    /// LU factors are kept: Newton renews the Jacobian by itself when it converges slowly, and
+    /// the error test shrinks a step that the change made too long. Cheaper than
+    /// [`Self::restart`], which forgets all of them.
+    pub fn equations_changed(&mut self) {
+        self.f0_valid = false;
+        self.jac_current = false;
+    }
+
     /// Continue after a discontinuity at the current time (a parameter switch, a jump of the
     /// state): keep t and y, or take `y`; forget the interpolation polynomial, the Jacobian,
     /// the LU factors and the controller's history. The next step starts from the current

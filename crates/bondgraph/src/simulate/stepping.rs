@@ -1,0 +1,662 @@
+//! [`Simulation`]: a run advanced by the caller, call by call, with the solver's state kept
+//! in between — for a controller written outside the model (Python, a test bench) that reads
+//! the model, sets its inputs and lets it run on for one sample.
+//!
+//! The method is our Radau IIA ([`crate::radau`]). Between calls it keeps everything a run
+//! keeps between steps: the step size the controller proposed, the Jacobian and its LU
+//! factors, the collocation polynomial (the next Newton's starting values). A call ends
+//! exactly on its target time (the last step is shortened to land there, which does not
+//! shrink the step size proposed for the next call), so advancing in many short calls costs
+//! what one run costs plus, per call, one short landing step and the LU factorisations of
+//! its step size and of the next (at most two per call; an LU of the crane's 38 states costs
+//! about as much as a right-hand side) — no Jacobian per call.
+//!
+//! What changes the equations at the current time without a jump of the state — an input
+//! set to a new value ([`Simulation::set_input`]), a corner of an input's series (a stop, as
+//! in a run) — costs one right-hand side: the
+//! integrator evaluates f(t, y) anew and keeps its step size, Jacobian and LU (Newton renews
+//! the Jacobian itself when it converges slowly; the error test shrinks a step the change
+//! made too long). A scheduled [`Event`] (elements replaced) and [`Simulation::restart`] make
+//! a full restart: Jacobian, LU and step-size history are forgotten.
+//!
+//! Limits, non-finite states, `max_steps` and `Settings::interrupt` stop a call as they
+//! stop a run (the same loop, `stepper::drive`); after an error the simulation refuses to go
+//! on.
+
+use std::cell::RefCell;
+
+use super::radau::{RadauEquations, RadauStepper, RADAU_JACOBIAN_THETA};
+use super::stepper::drive;
+use super::{bounds, same_time, Bound, Event, Grid, Progress, Recorder, Settings, Statistics};
+use crate::equations::{Probe, StateEquations};
+use crate::error::SimulationError;
+use crate::radau::{Radau5, RadauOptions};
+
+/// A run advanced call by call ([`Simulation::advance_to`]); see the module doc.
+#[derive(Debug)]
+pub struct Simulation {
+    eqs: StateEquations,
+    /// `None` only for a model without states (nothing to integrate).
+    radau: Option<Radau5>,
+    /// The time of a model without states.
+    t: f64,
+    limits: Vec<Bound>,
+    /// Scheduled events not yet applied, latest first.
+    events: Vec<Event>,
+    settings: Settings,
+    rhs_calls: usize,
+    jac_calls: usize,
+    events_applied: usize,
+    /// Wall time spent in `advance_to`.
+    wall: std::time::Duration,
+    /// Why the simulation cannot go on, once it failed.
+    failed: Option<SimulationError>,
+}
+
+impl Simulation {
+    /// Start at (`t0`, `x0`) with the tolerances and `max_steps` of `settings` (its times and
+    /// method are not used: the method is Radau IIA). `events` are applied at their times;
+    /// those at or before `t0` at once.
+    ///
+    /// # Errors
+    /// A state count or value that does not fit, a limit already crossed, bad tolerances, or
+    /// equations that are not finite at the start.
+    pub fn start(
+        mut eqs: StateEquations,
+        t0: f64,
+        x0: &[f64],
+        settings: &Settings,
+        mut events: Vec<Event>,
+    ) -> Result<Self, SimulationError> {
+        let bad_setting = |setting, message: String| SimulationError::InvalidSetting {
+            setting,
+            message,
+            hint: None,
+        };
+        if !t0.is_finite() {
+            return Err(bad_setting("t0", format!("must be finite, got {t0}")));
+        }
+        if !(settings.rtol.is_finite() && (super::MIN_RTOL..1.0).contains(&settings.rtol)) {
+            return Err(bad_setting(
+                "rtol",
+                format!(
+                    "must be in [{:e}, 1), got {}",
+                    super::MIN_RTOL,
+                    settings.rtol
+                ),
+            ));
+        }
+        if !(settings.atol.is_finite() && settings.atol > 0.0) {
+            return Err(bad_setting(
+                "atol",
+                format!("must be finite and > 0, got {}", settings.atol),
+            ));
+        }
+        if x0.len() != eqs.n_states() {
+            return Err(SimulationError::InitialState {
+                given: x0.len(),
+                expected: eqs.n_states(),
+            });
+        }
+        if let Some((i, v)) = x0.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            let s = &eqs.states()[i];
+            return Err(SimulationError::NonFinite {
+                t: t0,
+                state: s.name.clone(),
+                element: eqs.graph().node(s.element).name.clone(),
+                value: *v,
+                culprit: " (initial value)".into(),
+            });
+        }
+        let limits = bounds(&eqs);
+        if let Some(b) = limits.iter().find(|b| b.margin(x0) < 0.0) {
+            return Err(b.error(t0));
+        }
+        events.sort_by(|a, b| b.t.total_cmp(&a.t));
+        let mut applied = 0;
+        while events
+            .last()
+            .is_some_and(|e| e.t <= t0 || same_time(e.t, t0))
+        {
+            if let Some(ev) = events.pop() {
+                apply(&mut eqs, ev)?;
+                applied += 1;
+            }
+        }
+        let radau = if x0.is_empty() {
+            None
+        } else {
+            let atol: Vec<f64> = eqs
+                .states()
+                .iter()
+                .map(|s| settings.atol * s.nominal)
+                .collect();
+            let options = RadauOptions {
+                rtol: settings.rtol,
+                atol,
+                jacobian_theta: RADAU_JACOBIAN_THETA,
+                ..RadauOptions::default()
+            };
+            let bad = RefCell::new(None);
+            let mut sys = RadauEquations {
+                eqs: &eqs,
+                bad: &bad,
+                rhs_calls: 0,
+                jac_calls: 0,
+            };
+            let r =
+                Radau5::new(&mut sys, t0, x0, options).map_err(|e| SimulationError::Solver {
+                    t: t0,
+                    message: e.to_string(),
+                    culprit: super::culprit(&eqs, &bad),
+                    hint: None,
+                })?;
+            Some(r)
+        };
+        Ok(Self {
+            eqs,
+            radau,
+            t: t0,
+            limits,
+            events,
+            settings: settings.clone(),
+            rhs_calls: 1,
+            jac_calls: 0,
+            events_applied: applied,
+            wall: std::time::Duration::ZERO,
+            failed: None,
+        })
+    }
+
+    /// The current time.
+    #[must_use]
+    pub fn t(&self) -> f64 {
+        self.radau.as_ref().map_or(self.t, Radau5::t)
+    }
+
+    /// The current state, in the order of [`StateEquations::states`].
+    #[must_use]
+    pub fn state(&self) -> &[f64] {
+        self.radau.as_ref().map_or(&[], Radau5::y)
+    }
+
+    /// The equations (names, probes).
+    #[must_use]
+    pub fn equations(&self) -> &StateEquations {
+        &self.eqs
+    }
+
+    /// The equations, to change them at the current time (an input's value). Call
+    /// [`Self::equations_changed`] afterwards if f changed.
+    pub fn equations_mut(&mut self) -> &mut StateEquations {
+        &mut self.eqs
+    }
+
+    /// Give the equations back.
+    #[must_use]
+    pub fn into_equations(self) -> StateEquations {
+        self.eqs
+    }
+
+    /// The equations changed at the current time, the state did not jump: one right-hand side
+    /// before the next step, nothing forgotten (see the module doc).
+    pub fn equations_changed(&mut self) {
+        if let Some(r) = self.radau.as_mut() {
+            r.equations_changed();
+        }
+    }
+
+    /// Hold input `i` at `value` from now on. A new value changes f at the current time:
+    /// the integrator re-evaluates it before the next step and keeps its step size,
+    /// Jacobian and LU ([`Self::equations_changed`]); the same value changes nothing.
+    ///
+    /// # Errors
+    /// [`GraphError::UnknownInput`](crate::GraphError::UnknownInput) for an index out of range.
+    pub fn set_input(&mut self, i: usize, value: f64) -> Result<(), crate::GraphError> {
+        let t = self.t();
+        let same = self.eqs.input_series(i)?.is_none()
+            && self.eqs.input_value(i, t)?.to_bits() == value.to_bits();
+        if !same {
+            self.eqs.set_input(i, value)?;
+            self.equations_changed();
+        }
+        Ok(())
+    }
+
+    /// Make input `i` follow `series` from now on (its corners become stops, as in a run).
+    ///
+    /// # Errors
+    /// [`GraphError::UnknownInput`](crate::GraphError::UnknownInput) for an index out of range.
+    pub fn set_input_series(
+        &mut self,
+        i: usize,
+        series: crate::elements::Series,
+    ) -> Result<(), crate::GraphError> {
+        self.eqs.set_input_series(i, series)?;
+        self.equations_changed();
+        Ok(())
+    }
+
+    /// Restart the integrator at the current time, optionally from a new state: the
+    /// Jacobian, its LU and the step-size history are forgotten.
+    ///
+    /// # Errors
+    /// A state of the wrong length or not finite.
+    pub fn restart(&mut self, x: Option<&[f64]>) -> Result<(), SimulationError> {
+        let t = self.t();
+        if let Some(r) = self.radau.as_mut() {
+            r.restart(x).map_err(|e| SimulationError::Solver {
+                t,
+                message: e.to_string(),
+                culprit: String::new(),
+                hint: None,
+            })?;
+        }
+        Ok(())
+    }
+
+    /// The value of `probe` at the current time and state.
+    #[must_use]
+    pub fn read(&self, probe: Probe) -> f64 {
+        let (t, x) = (self.t(), self.state());
+        if let Probe::State(i) = probe {
+            return x[i];
+        }
+        self.eqs.evaluate(t, x);
+        self.eqs.read(probe, t, x)
+    }
+
+    /// Solver work since the start, summed over every call.
+    #[must_use]
+    pub fn stats(&self) -> Statistics {
+        let mut s = Statistics {
+            rhs_evals: self.rhs_calls,
+            jac_evals: self.jac_calls,
+            jac_assemblies: self.jac_calls,
+            events: self.events_applied,
+            wall_time: self.wall,
+            ..Statistics::default()
+        };
+        if let Some(r) = &self.radau {
+            let w = r.stats();
+            s.steps = w.steps;
+            s.error_test_failures = w.rejected;
+            s.newton_iterations = w.newton_iterations;
+            s.newton_failures = w.newton_failures;
+            s.lu_factorisations = w.lu_decompositions;
+        }
+        s
+    }
+
+    /// Advance by `dt` (> 0).
+    ///
+    /// # Errors
+    /// As [`Self::advance_to`].
+    pub fn advance(&mut self, dt: f64) -> Result<(), SimulationError> {
+        self.advance_to(self.t() + dt)
+    }
+
+    /// Integrate on to `t_target`, landing on it exactly, applying the events due on the way.
+    /// A target equal to the current time does nothing.
+    ///
+    /// # Errors
+    /// A target behind the current time; the solver failing, a state not finite, a limit
+    /// reached, `max_steps` or an interruption (the state is then where it stopped, and every
+    /// later call returns the same error).
+    pub fn advance_to(&mut self, t_target: f64) -> Result<(), SimulationError> {
+        if let Some(e) = &self.failed {
+            return Err(e.clone());
+        }
+        let t_now = self.t();
+        if !t_target.is_finite() || t_target < t_now {
+            return Err(SimulationError::InvalidSetting {
+                setting: "t",
+                message: format!(
+                    "cannot advance to t = {t_target}: the simulation is at t = {t_now} and only goes forward"
+                ),
+                hint: None,
+            });
+        }
+        let start = std::time::Instant::now();
+        let result = self.advance_inner(t_target);
+        self.wall += start.elapsed();
+        if let Err(e) = &result {
+            self.failed = Some(e.clone());
+        }
+        result
+    }
+
+    fn advance_inner(&mut self, t_target: f64) -> Result<(), SimulationError> {
+        loop {
+            let t = self.t();
+            if same_time(t, t_target) || t >= t_target {
+                return Ok(());
+            }
+            let next_event = self.events.last().map(|e| e.t);
+            let t_stop = next_event.map_or(t_target, |te| te.min(t_target));
+            // An input series' corner is a stop too: the series is evaluated on one piece
+            // up to it, and f changes there as it does when an input is set.
+            let corner = self.eqs.next_breakpoint(t).filter(|&b| b < t_stop);
+            let t_stop = corner.unwrap_or(t_stop);
+            self.eqs.begin_segment(t);
+            if !same_time(t, t_stop) {
+                self.integrate(t_stop)?;
+            }
+            if corner.is_some() {
+                self.equations_changed();
+            }
+            if next_event.is_some_and(|te| same_time(te, t_stop) || te <= t_stop) {
+                while self
+                    .events
+                    .last()
+                    .is_some_and(|e| same_time(e.t, t_stop) || e.t <= t_stop)
+                {
+                    if let Some(ev) = self.events.pop() {
+                        apply(&mut self.eqs, ev)?;
+                        self.events_applied += 1;
+                    }
+                }
+                self.restart(None)?;
+            }
+            if self.radau.is_none() {
+                self.t = t_stop;
+            }
+        }
+    }
+
+    /// Step the integrator onto `t_stop` through the run's loop (`drive`).
+    fn integrate(&mut self, t_stop: f64) -> Result<(), SimulationError> {
+        let Some(radau) = self.radau.take() else {
+            return Ok(());
+        };
+        let bad = RefCell::new(None);
+        let mut none: Vec<Vec<f64>> = Vec::new();
+        let mut rec = Recorder {
+            eqs: &self.eqs,
+            outputs: &[],
+            // An empty grid: no rows (`pending` is always `None`).
+            grid: Grid {
+                t0: t_stop,
+                dt: 1.0,
+                n: 0,
+                t_end: t_stop,
+                end_extra: false,
+            },
+            sink: &mut none,
+            interrupt: self.settings.interrupt.as_deref(),
+            wants_steps: false,
+            event_at: None,
+            buf: Vec::new(),
+            p: Progress {
+                watchers: Vec::new(),
+                next: 1,
+                rows: 0,
+                stop: None,
+            },
+        };
+        let mut stepper = RadauStepper {
+            radau,
+            sys: RadauEquations {
+                eqs: &self.eqs,
+                bad: &bad,
+                rhs_calls: 0,
+                jac_calls: 0,
+            },
+            t_stop,
+            limits: &self.limits,
+        };
+        // Steps are counted by the integrator over its life; `drive` only needs them for
+        // `max_steps`.
+        let mut scratch = Statistics::default();
+        let result = drive(
+            &mut stepper,
+            &mut rec,
+            t_stop,
+            self.settings.max_steps,
+            &self.limits,
+            &bad,
+            &mut scratch,
+        );
+        self.rhs_calls += stepper.sys.rhs_calls;
+        self.jac_calls += stepper.sys.jac_calls;
+        self.radau = Some(stepper.radau);
+        result.map(|_| ()).map_err(|(_, _, e)| e)
+    }
+}
+
+/// Apply one event's replacements, all or nothing.
+fn apply(eqs: &mut StateEquations, ev: Event) -> Result<(), SimulationError> {
+    if let Some(source) = ev
+        .replacements
+        .iter()
+        .find_map(|(id, el)| eqs.check_replacement(*id, el.as_ref()).err())
+    {
+        return Err(SimulationError::Event { t: ev.t, source });
+    }
+    for (id, el) in ev.replacements {
+        eqs.replace(id, el)
+            .map_err(|source| SimulationError::Event { t: ev.t, source })?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::{
+        assign_causality, simulate, BondGraph, Capacitor, EffortSource, Inertia, OneJunction,
+        Output, Resistor,
+    };
+
+    /// m = 1, k = 100, c = 2 pushed by 10 N, from rest.
+    fn msd() -> StateEquations {
+        let mut g = BondGraph::new();
+        g.add("force", EffortSource::new(10.0)).unwrap();
+        g.add("v", OneJunction).unwrap();
+        g.add("mass", Inertia::new(1.0, 0.0).unwrap()).unwrap();
+        g.add("spring", Capacitor::new(1.0 / 100.0, 0.0).unwrap())
+            .unwrap();
+        g.add("damper", Resistor::new(2.0).unwrap()).unwrap();
+        for (a, b) in [
+            ("force", "v"),
+            ("v", "mass"),
+            ("v", "spring"),
+            ("v", "damper"),
+        ] {
+            g.connect_names(a, b).unwrap();
+        }
+        StateEquations::new(assign_causality(g).unwrap()).unwrap()
+    }
+
+    fn settings() -> Settings {
+        Settings {
+            t_end: 3.0,
+            dt_out: 0.01,
+            rtol: 1e-8,
+            atol: 1e-10,
+            ..Settings::default()
+        }
+    }
+
+    /// x(t) of the MSD under a 10 N step: x∞ = 0.1, ω_d = √99, σ = 1.
+    fn exact(t: f64) -> f64 {
+        let wd = 99f64.sqrt();
+        0.1 * (1.0 - (-t).exp() * ((wd * t).cos() + (wd * t).sin() / wd))
+    }
+
+    /// 300 calls of 10 ms end where one run ends (to the tolerance), and where the closed
+    /// form is; the calls cost no Jacobian or LU of their own.
+    #[test]
+    fn many_short_advances_equal_one_run() {
+        let s = settings();
+        let mut eqs = msd();
+        let x0 = eqs.initial_state();
+        let probe = eqs.probe("spring.q").unwrap();
+        let outputs = [Output {
+            name: "x".into(),
+            probe,
+        }];
+        let run = simulate(&mut eqs, &x0, &s, &outputs, vec![]);
+        assert!(run.error.is_none());
+        let x_run = *run.trajectory.column("x").unwrap().last().unwrap();
+
+        let mut sim = Simulation::start(msd(), 0.0, &x0, &s, vec![]).unwrap();
+        let mut worst = 0.0f64;
+        for k in 1..=300 {
+            sim.advance_to(k as f64 * 0.01).unwrap();
+            assert!((sim.t() - k as f64 * 0.01).abs() < 1e-15);
+            worst = worst.max((sim.read(probe) - exact(sim.t())).abs());
+        }
+        let x_step = sim.read(probe);
+        let st = sim.stats();
+        eprintln!(
+            "300 advances: x = {x_step:.12} (one run {x_run:.12}, exact {:.12}), worst error {worst:.1e}; stepping {st}; one run {}",
+            exact(3.0),
+            run.stats
+        );
+        assert!((x_step - x_run).abs() < 1e-8, "{x_step} vs {x_run}");
+        assert!(worst < 1e-8, "{worst}");
+        // No restart per call: a restart costs a Jacobian, so 300 calls would cost ≥ 300. The
+        // Jacobians are those of a run within a small margin; the LUs at most the run's plus
+        // two per call (the landing step's h and the next one's).
+        assert!(st.jac_evals <= run.stats.jac_evals + 5, "{st}");
+        assert!(
+            st.lu_factorisations <= run.stats.lu_factorisations + 2 * 300,
+            "{st}"
+        );
+        assert!(st.steps >= 300);
+    }
+
+    /// A changed source at the current time (as an input set to a new value) costs no
+    /// Jacobian and no LU, and the solution follows the new force exactly.
+    #[test]
+    fn a_changed_force_costs_no_restart() {
+        let s = settings();
+        let eqs = msd();
+        let x0 = eqs.initial_state();
+        let force = eqs.graph().find("force").unwrap();
+        let probe = eqs.probe("spring.q").unwrap();
+        let mut sim = Simulation::start(eqs, 0.0, &x0, &s, vec![]).unwrap();
+        sim.advance_to(1.0).unwrap();
+        let before = sim.stats();
+        sim.equations_mut()
+            .replace(force, Box::new(EffortSource::new(20.0)))
+            .unwrap();
+        sim.equations_changed();
+        for k in 1..=100 {
+            sim.advance_to(1.0 + k as f64 * 0.01).unwrap();
+        }
+        let after = sim.stats();
+        // x(t) = exact(t) for 10 N plus the response to a 10 N step at t = 1.
+        let want = exact(2.0) + exact(1.0);
+        let got = sim.read(probe);
+        eprintln!(
+            "force doubled at t = 1: x(2) = {got:.12}, exact {want:.12}; work over the 100 calls after: {} Jacobians, {} LUs, {} steps",
+            after.jac_evals - before.jac_evals,
+            after.lu_factorisations - before.lu_factorisations,
+            after.steps - before.steps
+        );
+        assert!((got - want).abs() < 1e-8, "{got} vs {want}");
+        assert!(after.jac_evals - before.jac_evals <= 3, "{after}");
+        assert!(
+            after.lu_factorisations - before.lu_factorisations <= 3 * 100,
+            "{after}"
+        );
+    }
+
+    /// The same through an external input: set to a new value between calls, the same value
+    /// again costs nothing; a series' corner inside a call is a stop.
+    #[test]
+    fn an_input_set_between_calls_and_a_series_corner() {
+        let s = settings();
+        let mut g = BondGraph::new();
+        let spec = crate::InputSpec {
+            name: "F".into(),
+            unit: "N".into(),
+            default: 10.0,
+            description: String::new(),
+        };
+        g.add("F", crate::Input::new(spec).unwrap()).unwrap();
+        let force = EffortSource::new(crate::Param::modulated(vec!["F".into()], |_, u| u[0]));
+        g.add("force", force).unwrap();
+        g.add("v", OneJunction).unwrap();
+        g.add("mass", Inertia::new(1.0, 0.0).unwrap()).unwrap();
+        g.add("spring", Capacitor::new(0.01, 0.0).unwrap()).unwrap();
+        g.add("damper", Resistor::new(2.0).unwrap()).unwrap();
+        for (a, b) in [
+            ("force", "v"),
+            ("v", "mass"),
+            ("v", "spring"),
+            ("v", "damper"),
+        ] {
+            g.connect_names(a, b).unwrap();
+        }
+        let eqs = StateEquations::new(assign_causality(g).unwrap()).unwrap();
+        let x0 = eqs.initial_state();
+        let probe = eqs.probe("spring.q").unwrap();
+        let mut sim = Simulation::start(eqs, 0.0, &x0, &s, vec![]).unwrap();
+        for k in 1..=100 {
+            sim.set_input(0, 10.0).unwrap(); // unchanged: nothing happens
+            sim.advance_to(k as f64 * 0.01).unwrap();
+        }
+        let rhs_before = sim.stats().rhs_evals;
+        sim.set_input(0, 20.0).unwrap();
+        for k in 101..=200 {
+            sim.advance_to(k as f64 * 0.01).unwrap();
+        }
+        assert!(sim.stats().rhs_evals > rhs_before);
+        let want = exact(2.0) + exact(1.0);
+        assert!((sim.read(probe) - want).abs() < 1e-8);
+        // a held series stepping back to 10 N at t = 2.505, inside the next call
+        let series =
+            crate::Series::new(vec![2.0, 2.505], vec![20.0, 10.0], crate::Interp::Hold).unwrap();
+        sim.set_input_series(0, series).unwrap();
+        sim.advance_to(3.0).unwrap();
+        let want = exact(3.0) + exact(2.0) - exact(3.0 - 2.505);
+        let got = sim.read(probe);
+        assert!((got - want).abs() < 1e-8, "{got} vs {want}");
+    }
+
+    #[test]
+    fn going_back_is_refused_and_a_failure_sticks() {
+        let s = settings();
+        let eqs = msd();
+        let x0 = eqs.initial_state();
+        let mut sim = Simulation::start(eqs, 0.0, &x0, &s, vec![]).unwrap();
+        sim.advance(0.5).unwrap();
+        sim.advance_to(0.5).unwrap();
+        let e = sim.advance_to(0.25).unwrap_err();
+        assert!(e.to_string().contains("only goes forward"), "{e}");
+        assert!(Simulation::start(msd(), 0.0, &[0.0], &s, vec![]).is_err());
+    }
+
+    /// A scheduled event is applied on the way, as in a run.
+    #[test]
+    fn events_on_the_way_as_in_a_run() {
+        let s = settings();
+        let mut eqs = msd();
+        let force = eqs.graph().find("force").unwrap();
+        let x0 = eqs.initial_state();
+        let probe = eqs.probe("spring.q").unwrap();
+        let ev = || {
+            vec![Event {
+                t: 1.005,
+                replacements: vec![(force, Box::new(EffortSource::new(20.0)) as Box<_>)],
+            }]
+        };
+        let outputs = [Output {
+            name: "x".into(),
+            probe,
+        }];
+        let run = simulate(&mut eqs, &x0, &s, &outputs, ev());
+        let x_run = *run.trajectory.column("x").unwrap().last().unwrap();
+        let mut sim = Simulation::start(msd(), 0.0, &x0, &s, ev()).unwrap();
+        for k in 1..=300 {
+            sim.advance_to(k as f64 * 0.01).unwrap();
+        }
+        assert_eq!(sim.stats().events, 1);
+        let got = sim.read(probe);
+        assert!((got - x_run).abs() < 1e-8, "{got} vs {x_run}");
+    }
+}
