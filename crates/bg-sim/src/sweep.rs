@@ -119,6 +119,16 @@ pub fn sweep(
         .map_err(|e| err(&file, format!("cannot read the model: {e}")))?;
     // the model must load as written: a mistake common to every run is an error, not N rows
     Model::from_text(&file, &text, &registry(), &[]).map_err(|e| err(&file, e.to_string()))?;
+    // a spec parameter the model lacks is a mistake common to every run (issue 24, item 8):
+    // the path is checked once, with any value, before a run starts
+    for (path, _) in &spec.parameters {
+        bg_model::overrides::apply(&file, &text, &[format!("{path}=0")]).map_err(|e| {
+            err(
+                &file,
+                format!("the sweep's parameter `{path}` is not in the model, so no run could use it: {e}"),
+            )
+        })?;
+    }
     let all = points(spec);
     fs::create_dir_all(&opts.out_dir).map_err(|e| {
         err(
