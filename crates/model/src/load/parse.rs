@@ -222,6 +222,7 @@ pub(super) fn parse(
         events: Vec::new(),
         changed_lines,
         plots: Vec::new(),
+        line_starts: super::source::line_starts(&text),
     };
     let mut problems = Vec::new();
     let mut failed = Failed::default();
