@@ -347,7 +347,7 @@ impl Problem<'_> {
                 Condition::Derivative { state, .. } | Condition::State { state, .. } => x[*state],
             };
             let tol = settle.tolerance(c, &x, v);
-            if !(r[i].abs() <= tol) {
+            if tol.is_nan() || r[i].abs() > tol {
                 return None;
             }
             own_scale.push((condition_name(self.eqs, c), r[i], tol));
