@@ -1,5 +1,6 @@
-//! Fuzz target over the model loader and the expression parser: generated inputs must give
-//! a value or an error, never a panic, a stack overflow or a hang.
+//! Fuzz target over the model loader, the expression parser and the inputs of the CLI's
+//! other commands (a results CSV for `plot` and `compare`, a sweep spec for `sweep`):
+//! generated inputs must give a value or an error, never a panic, a stack overflow or a hang.
 //!
 //! cargo-fuzz needs a nightly toolchain; this is the same idea on proptest, run as a test:
 //! a corpus built from `models/` (every model file, whole), mutated with structure in mind
@@ -8,8 +9,10 @@
 //! bytes flipped; `--set` overrides on the file's own keys), each loaded with every element
 //! kind the CLI knows.
 //!
-//! Cases: `BG_FUZZ_CASES` (default 300 per target, a few seconds in CI); seed: `BG_FUZZ_SEED`
-//! (default fixed, so CI is reproducible; set another for a new sweep). A local sweep:
+//! Cases: `BG_FUZZ_CASES` (default 300 per target, a few seconds in CI). Seed: `BG_FUZZ_SEED`,
+//! or else the commit under test (the first 16 hex digits of `git rev-parse HEAD`, so each
+//! commit explores new inputs), or else (no git) a fixed one. Each target prints its seed,
+//! and a failure names it: `BG_FUZZ_SEED=N` reproduces it. A local sweep:
 //! `BG_FUZZ_CASES=500000 BG_FUZZ_SEED=7 cargo test -p bg-tests --test fuzz -- --nocapture`.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -29,11 +32,55 @@ fn cases() -> u32 {
         .unwrap_or(300)
 }
 
-fn runner() -> TestRunner {
-    let seed: u64 = std::env::var("BG_FUZZ_SEED")
+/// The seed and where it came from: `BG_FUZZ_SEED`, the commit, or the fixed fallback.
+fn seed() -> (u64, String) {
+    if let Some(s) = std::env::var("BG_FUZZ_SEED")
         .ok()
         .and_then(|s| s.parse().ok())
-        .unwrap_or(20_261_201);
+    {
+        return (s, "BG_FUZZ_SEED".into());
+    }
+    let head = std::process::Command::new("git")
+        .args(["rev-parse", "HEAD"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_owned());
+    match head
+        .as_deref()
+        .and_then(|h| Some((h, u64::from_str_radix(h.get(..16)?, 16).ok()?)))
+    {
+        Some((h, s)) => (s, format!("commit {}", &h[..h.len().min(12)])),
+        None => (20_261_201, "fixed: not in a git checkout".into()),
+    }
+}
+
+/// Run `test` over `strategy` with the seed; print it (and the count and time); on a
+/// failure, panic naming the seed that reproduces it.
+fn fuzz<S: Strategy>(
+    target: &str,
+    strategy: &S,
+    test: impl Fn(S::Value) -> Result<(), TestCaseError>,
+) {
+    let (seed, from) = seed();
+    eprintln!(
+        "{target}: seed {seed} ({from}); reproduce with BG_FUZZ_SEED={seed} BG_FUZZ_CASES={}",
+        cases()
+    );
+    let start = Instant::now();
+    let result = runner(seed).run(strategy, test);
+    eprintln!(
+        "{target}: {} inputs in {:.1} s (seed {seed})",
+        cases(),
+        start.elapsed().as_secs_f64()
+    );
+    if let Err(e) = result {
+        panic!("{target} failed with BG_FUZZ_SEED={seed}: {e}");
+    }
+}
+
+fn runner(seed: u64) -> TestRunner {
     let mut bytes = [0u8; 32];
     bytes[..8].copy_from_slice(&seed.to_le_bytes());
     let config = Config {
@@ -357,9 +404,8 @@ fn fuzz_model_loader() {
         prop::collection::vec(mutation(), 1..=3),
         overrides(),
     );
-    let start = Instant::now();
     let loaded = std::cell::Cell::new(0usize);
-    let result = runner().run(&strategy, |(k, mutations, set)| {
+    fuzz("fuzz_model_loader", &strategy, |(k, mutations, set)| {
         let (name, text) = &corpus[k];
         let mut mutated = text.clone();
         for m in &mutations {
@@ -375,15 +421,7 @@ fn fuzz_model_loader() {
             ))),
         }
     });
-    eprintln!(
-        "fuzz_model_loader: {} inputs ({} loaded) in {:.1} s",
-        cases(),
-        loaded.get(),
-        start.elapsed().as_secs_f64()
-    );
-    if let Err(e) = result {
-        panic!("{e}");
-    }
+    eprintln!("fuzz_model_loader: {} loaded", loaded.get());
 }
 
 /// The expression parser and evaluator over generated and mutated expressions.
@@ -393,8 +431,7 @@ fn fuzz_expression_parser() {
         expression(),
         prop::collection::vec((any::<usize>(), prop::sample::select(TOKENS)), 0..3),
     );
-    let start = Instant::now();
-    let result = runner().run(&strategy, |(e, inserts)| {
+    fuzz("fuzz_expression_parser", &strategy, |(e, inserts)| {
         let mut s = e;
         for (i, t) in inserts {
             let k = char_index(&s, i);
@@ -415,12 +452,162 @@ fn fuzz_expression_parser() {
         }))
         .map_err(|p| TestCaseError::fail(format!("`{s}` panicked: {}", panic_message(p.as_ref()))))
     });
-    eprintln!(
-        "fuzz_expression_parser: {} inputs in {:.1} s",
-        cases(),
-        start.elapsed().as_secs_f64()
-    );
-    if let Err(e) = result {
-        panic!("{e}");
+}
+
+/// A results CSV as `bg-sim run` writes it: `t` and two columns, `rows` rows.
+fn results_csv(rows: usize) -> String {
+    let mut s = String::from("t,x,F_c1\n");
+    for k in 0..rows {
+        let t = k as f64 * 0.05;
+        s += &format!("{t},{},{}\n", (3.0 * t).sin(), 5e5 + 1e5 * t);
     }
+    s
+}
+
+/// Numbers a results cell may become: the extremes of a model file and the values a
+/// diverged run writes.
+const CELLS: &[&str] = &[
+    "NaN",
+    "inf",
+    "-inf",
+    "1e308",
+    "-1e308",
+    "1.7976931348623157e308",
+    "5e-324",
+    "-0",
+    "0",
+    "1e-320",
+    "",
+    " ",
+    "x",
+    "1e",
+    "1,2",
+];
+
+/// `bg-sim plot` and `bg-sim compare` over mutated results CSVs: read, drawn (a quick look,
+/// as SVG) and scored against themselves and the unmutated file. Each must give figures or
+/// an error, never a panic or a hang (issue 24: ±1e308 in a column hung `plot`; NaN scored
+/// as a result in `compare`).
+#[test]
+fn fuzz_plot_and_compare_inputs() {
+    use bg_sim::bench::{unscorable, Reference};
+    use bg_sim::plot::{draw, quick_look, Format, Results};
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("r.csv");
+    let strategy = (
+        1usize..40,
+        prop::collection::vec(
+            prop_oneof![
+                3 => (any::<usize>(), prop::sample::select(CELLS)).prop_map(|(i, v)| Mutation::Number(i, v)),
+                1 => mutation(),
+            ],
+            1..=4,
+        ),
+        prop::sample::select(vec!["x", "F_c1", "t", "nope"]),
+    );
+    let original = Results::parse(&results_csv(40)).unwrap();
+    fuzz(
+        "fuzz_plot_and_compare_inputs",
+        &strategy,
+        |(rows, mutations, column)| {
+            let mut text = results_csv(rows);
+            for m in &mutations {
+                text = apply(&text, m);
+            }
+            catch_unwind(AssertUnwindSafe(|| {
+                let Ok(table) = Results::parse(&text) else {
+                    return;
+                };
+                if let Ok(plot) = quick_look(&table, &path, "r", &[column.to_owned()]) {
+                    let _ = draw(&table, &plot, dir.path(), Format::Svg);
+                }
+                let run = table.to_trajectory();
+                for reference in [&table, &original] {
+                    let t = reference.time().to_vec();
+                    let named = reference
+                        .names()
+                        .iter()
+                        .skip(1)
+                        .filter_map(|n| reference.column(n).map(|c| (n.clone(), c.to_vec())))
+                        .collect();
+                    if let Ok(r) = Reference::new(t, named, None, &[]) {
+                        let _ = unscorable(&path, &r, |n| table.column(n));
+                        let _ = r.errors(&run);
+                        let _ = r.worst(&run);
+                    }
+                }
+            }))
+            .map_err(|p| {
+                TestCaseError::fail(format!(
+                    "{mutations:?} on {rows} rows panicked: {}\n{text}",
+                    panic_message(p.as_ref())
+                ))
+            })
+        },
+    );
+}
+
+/// The sweep specs of the docs (`docs/sweeps/*.toml` and the spec in `docs/sweeps.md`).
+fn sweep_specs() -> Vec<(String, String)> {
+    let docs = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs");
+    let mut out: Vec<(String, String)> = std::fs::read_dir(docs.join("sweeps"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .map(|p| {
+            (
+                p.file_name().unwrap().to_string_lossy().into_owned(),
+                std::fs::read_to_string(&p).unwrap(),
+            )
+        })
+        .collect();
+    let md = std::fs::read_to_string(docs.join("sweeps.md")).unwrap();
+    if let Some((_, rest)) = md.split_once("```toml sweep-spec\n") {
+        if let Some((spec, _)) = rest.split_once("```") {
+            out.push(("sweeps.md".into(), spec.to_owned()));
+        }
+    }
+    out
+}
+
+/// `bg-sim sweep` specs: mutated specs parsed, their design laid out, and the first run's
+/// `--set` overrides applied to a model of `models/`. Each must give runs or an error, never a
+/// panic or a hang.
+#[test]
+fn fuzz_sweep_specs() {
+    use bg_sim::sweep::{parse_spec, points};
+    let specs = sweep_specs();
+    assert!(specs.len() >= 2, "docs/sweeps/*.toml and docs/sweeps.md");
+    let models = corpus();
+    let registry = bg_sim::registry();
+    let strategy = (
+        0..specs.len(),
+        0..models.len(),
+        prop::collection::vec(mutation(), 1..=3),
+    );
+    fuzz("fuzz_sweep_specs", &strategy, |(k, m, mutations)| {
+        let (name, text) = &specs[k];
+        let mut mutated = text.clone();
+        for mu in &mutations {
+            mutated = apply(&mutated, mu);
+        }
+        catch_unwind(AssertUnwindSafe(|| {
+            let Ok(spec) = parse_spec(name, &mutated) else {
+                return;
+            };
+            let design = points(&spec);
+            if let Some(first) = design.first() {
+                let _ = first.id();
+                let (model, text) = &models[m];
+                let _ = Model::from_text(model, text, &registry, &first.overrides())
+                    .map(|m| m.settings.validate());
+            }
+        }))
+        .map_err(|p| {
+            TestCaseError::fail(format!(
+                "{name} with {mutations:?} panicked: {}\n{mutated}",
+                panic_message(p.as_ref())
+            ))
+        })
+    });
 }

@@ -170,3 +170,45 @@ fn a_start_without_equilibrium_is_refused() {
         "{text}"
     );
 }
+
+/// Issue 24, item 1: a start converged to its rounding floor was refused because the
+/// residual was judged in the scaled measure alone. Asked for a scaled residual below
+/// what rounding allows (tol = 1e-18 on lift_circuit's three hose pressure rates, Pa/s;
+/// 1e-16 on the crane's fourteen conditions: pressure rates in Pa/s beside the arm's
+/// angular momentum rates in N·m and the lumped masses' in N), Newton stalls; before, the
+/// model was refused ("no equilibrium found"), now each condition is judged in its own
+/// scale (the state's error weight atol + rtol·|x| over the run's span) and the
+/// start is accepted, every residual within it and the conditions so judged named.
+#[test]
+fn a_start_at_its_rounding_floor_is_judged_in_each_conditions_own_scale() {
+    for (name, set) in [
+        ("lift_circuit", vec!["initial.steady.tol=1e-18"]),
+        (
+            "knuckle_boom",
+            vec!["initial.steady.use=rest", "initial.steady.rest.tol=1e-16"],
+        ),
+    ] {
+        let m = bg_tests::load(name, &set).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let report = m.steady.as_ref().unwrap();
+        eprintln!("{name}: {report}");
+        let own = &report.solution.own_scale;
+        assert!(!own.is_empty(), "{name}: {report}");
+        assert!(report.to_string().contains("judged in their own scale"));
+        let span = m.settings.t_end - m.settings.t_start;
+        for (c, r, tol) in own {
+            assert!(r.abs() <= *tol, "{name}: {c}: {r} > {tol}");
+            // a rate: at most the state's error weight over the run
+            let state = c.trim_end_matches(" = 0").trim_end_matches(".dot");
+            let x = state_value(&m, state);
+            let weight = m.settings.atol + m.settings.rtol * x.abs();
+            assert!(
+                (tol - bondgraph::OWN_SCALE_FRACTION * weight / span).abs() <= 1e-12 * tol,
+                "{name}: {c}: {tol} vs {weight}/{span}"
+            );
+        }
+    }
+}
+
+fn state_value(m: &Model, name: &str) -> f64 {
+    state(m, name)
+}

@@ -249,6 +249,50 @@ impl Reference {
     }
 }
 
+/// Why the columns `reference` scores cannot be scored in the file `path` (read through
+/// `column`): a time or a value that is NaN or infinite, or a column whose range (or
+/// scale) overflows f64 (1e308 beside −1e308), named with its first row. A score of NaN or
+/// infinity would read as a result; it is an error instead (issue 24, item 9).
+///
+/// # Errors
+/// The message: file, column, row and why.
+pub fn unscorable<'a>(
+    path: &Path,
+    reference: &Reference,
+    column: impl Fn(&str) -> Option<&'a [f64]>,
+) -> Result<(), String> {
+    let scored = std::iter::once(("t", None))
+        .chain(reference.columns.iter().map(|c| (c.0.as_str(), Some(c.2))));
+    for (name, scale) in scored {
+        let Some(values) = column(name) else {
+            continue;
+        };
+        let file = path.display();
+        if let Some((row, v)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(format!(
+                "{file}: column `{name}` holds {v} (data row {}): a comparison cannot score a non-finite value\n  hint: the run that wrote it stopped or diverged; compare the rows before it, or rerun",
+                row + 1
+            ));
+        }
+        let (lo, hi) = values
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+        if values.len() > 1 && !(hi - lo).is_finite() {
+            return Err(format!(
+                "{file}: column `{name}` spans {lo:e} to {hi:e}, a range that overflows f64: its errors cannot be scaled"
+            ));
+        }
+        if let Some(s) = scale.filter(|s| !(s.is_finite() && *s > 0.0)) {
+            return Err(format!(
+                "{file}: column `{name}` has the scale {s:e} (its range and mean in the reference): its errors cannot be scaled\n  hint: give it an error floor, e.g. --floor {name}=1e-9"
+            ));
+        }
+    }
+    Ok(())
+}
+
 fn interpolate(t: &[f64], v: &[f64], x: f64) -> f64 {
     let i = t.partition_point(|&ti| ti <= x);
     if i == 0 {

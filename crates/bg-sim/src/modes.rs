@@ -96,6 +96,12 @@ pub fn analyse(model: &mut Model, at: Option<f64>) -> Result<ModesReport, String
     })
 }
 
+/// A mode with |λ| at most this fraction of the largest |λ| is neutral: a rigid-body
+/// motion or an integrator (λ = 0 but for rounding: +6.5e-7 1/s beside 1e4 1/s is no
+/// instability). It is reported as neutral, with no damping ratio or time constant, and
+/// counted apart from the stiffness ratio (issue 24, item 4).
+pub const NEUTRAL: f64 = 1e-9;
+
 /// Damping ratio below which BDF of order 3, 4, 5 is not stable for a mode at large h·|λ|:
 /// cos of the stability angles α = 86.03°, 73.35°, 51.84° (Hairer & Wanner, Table V.2.3).
 const BDF_ZETA: [(usize, f64); 3] = [(3, 0.0692), (4, 0.2866), (5, 0.6180)];
@@ -112,10 +118,46 @@ impl ModesReport {
     }
 
     fn nonzero(&self) -> impl Iterator<Item = &Mode> {
-        let max = self.modes.first().map_or(0.0, |m| m.eigenvalue.norm());
-        self.modes
+        self.modes.iter().filter(move |m| !self.is_neutral(m))
+    }
+
+    /// Whether `m` is neutral: |λ| ≤ [`NEUTRAL`]·max|λ| (a model whose every |λ| is 0 has
+    /// only neutral modes).
+    #[must_use]
+    pub fn is_neutral(&self, m: &Mode) -> bool {
+        let max = self
+            .modes
             .iter()
-            .filter(move |m| m.eigenvalue.norm() > 1e-9 * max)
+            .map(|m| m.eigenvalue.norm())
+            .fold(0.0, f64::max);
+        m.eigenvalue.norm() <= NEUTRAL * max
+    }
+
+    /// One label per mode, distinct: its dominant state, or, where an earlier mode took it
+    /// (two equal lags share both states), its most participating state not yet taken;
+    /// `STATE #k` if every state of it is taken.
+    #[must_use]
+    pub fn labels(&self) -> Vec<String> {
+        let mut taken: Vec<String> = Vec::new();
+        for m in &self.modes {
+            let free = m
+                .participation
+                .iter()
+                .map(|&(i, _)| self.states[i].clone())
+                .find(|n| !taken.contains(n));
+            let label = free.unwrap_or_else(|| {
+                let first = m
+                    .participation
+                    .first()
+                    .map_or_else(|| "?".to_owned(), |&(i, _)| self.states[i].clone());
+                let k = (2..)
+                    .find(|k| !taken.contains(&format!("{first} #{k}")))
+                    .unwrap_or(2);
+                format!("{first} #{k}")
+            });
+            taken.push(label);
+        }
+        taken
     }
 
     /// What the time scales mean for the choice of solver, one sentence a line.
@@ -206,9 +248,10 @@ impl ModesReport {
         );
         let _ = writeln!(
             s,
-            "{:>3}  {:>12}  {:>12}  {:>9}  {:>11}  {:>24}  dominant states (participation)",
+            "{:>3}  {:>12}  {:>12}  {:>9}  {:>11}  {:>24}  mode: dominant states (participation)",
             "#", "f_n (Hz)", "f_d (Hz)", "ζ", "τ (s)", "λ (1/s)"
         );
+        let labels = self.labels();
         for (k, m) in self.modes.iter().enumerate() {
             let names = self
                 .dominant(m, top)
@@ -216,15 +259,29 @@ impl ModesReport {
                 .map(|(n, p)| format!("{n} {p:.2}"))
                 .collect::<Vec<_>>()
                 .join(", ");
+            let lambda = format!("{:.4e} {:+.4e}i", m.eigenvalue.re, m.eigenvalue.im);
+            if self.is_neutral(m) {
+                let _ = writeln!(
+                    s,
+                    "{:>3}  {:>12.6}  {:>12.6}  {:>9}  {:>11}  {lambda:>24}  {}: neutral (rigid-body or integrator; |λ| ≤ {NEUTRAL:e}·max|λ|): {names}",
+                    k + 1,
+                    m.natural_hz,
+                    m.damped_hz,
+                    "neutral",
+                    "—",
+                    labels[k],
+                );
+                continue;
+            }
             let _ = writeln!(
                 s,
-                "{:>3}  {:>12.6}  {:>12.6}  {:>9.5}  {:>11.4e}  {:>24}  {names}",
+                "{:>3}  {:>12.6}  {:>12.6}  {:>9.5}  {:>11.4e}  {lambda:>24}  {}: {names}",
                 k + 1,
                 m.natural_hz,
                 m.damped_hz,
                 m.damping_ratio,
                 m.time_constant,
-                format!("{:.4e} {:+.4e}i", m.eigenvalue.re, m.eigenvalue.im),
+                labels[k],
             );
         }
         for a in self.advice() {
@@ -244,23 +301,27 @@ impl ModesReport {
             }
         };
         let esc = |t: &str| t.replace('\\', "\\\\").replace('"', "\\\"");
+        let labels = self.labels();
         let modes: Vec<String> = self
             .modes
             .iter()
-            .map(|m| {
+            .zip(&labels)
+            .map(|(m, label)| {
+                let neutral = self.is_neutral(m);
                 let part: Vec<String> = self
                     .dominant(m, top)
                     .iter()
                     .map(|(n, p)| format!("{{\"state\": \"{}\", \"share\": {}}}", esc(n), num(*p)))
                     .collect();
                 format!(
-                    "{{\"re\": {}, \"im\": {}, \"natural_hz\": {}, \"damped_hz\": {}, \"damping_ratio\": {}, \"time_constant\": {}, \"participation\": [{}]}}",
+                    "{{\"label\": \"{}\", \"neutral\": {neutral}, \"re\": {}, \"im\": {}, \"natural_hz\": {}, \"damped_hz\": {}, \"damping_ratio\": {}, \"time_constant\": {}, \"participation\": [{}]}}",
+                    esc(label),
                     num(m.eigenvalue.re),
                     num(m.eigenvalue.im),
                     num(m.natural_hz),
                     num(m.damped_hz),
-                    num(m.damping_ratio),
-                    num(m.time_constant),
+                    if neutral { "null".into() } else { num(m.damping_ratio) },
+                    if neutral { "null".into() } else { num(m.time_constant) },
                     part.join(", ")
                 )
             })
@@ -280,5 +341,60 @@ impl ModesReport {
             modes.join(",\n  "),
             advice.join(", ")
         )
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    /// A real mode λ = `re`, as `bondgraph::modes` states it.
+    fn mode(re: f64, participation: Vec<(usize, f64)>) -> Mode {
+        let norm = re.abs();
+        Mode {
+            eigenvalue: re.into(),
+            natural_hz: norm / std::f64::consts::TAU,
+            damped_hz: 0.0,
+            damping_ratio: if norm > 0.0 { -re / norm } else { 0.0 },
+            time_constant: if re < 0.0 { -1.0 / re } else { f64::INFINITY },
+            participation,
+        }
+    }
+
+    /// Issue 24, item 4: two equal lags (a repeated eigenvalue whose eigenvectors both lean
+    /// on spool2.y) get distinct labels; a near-zero eigenvalue of +6.5e-7 beside −1e4 is
+    /// neutral, not an unstable mode with ζ = −1; the advice counts it apart.
+    #[test]
+    fn equal_lags_get_distinct_labels_and_a_near_zero_eigenvalue_is_neutral() {
+        let report = ModesReport {
+            model: "excavator".into(),
+            t: 0.0,
+            span: 10.0,
+            states: vec!["spool1.y".into(), "spool2.y".into(), "piston.x".into()],
+            modes: vec![
+                mode(-1e4, vec![(1, 0.6), (0, 0.4)]),
+                mode(-1e4, vec![(1, 0.55), (0, 0.45)]),
+                mode(6.5e-7, vec![(2, 1.0)]),
+            ],
+            stiffness_ratio: 1.0,
+            zero_modes: 1,
+        };
+        assert_eq!(report.labels(), ["spool2.y", "spool1.y", "piston.x"]);
+        let text = report.text(3);
+        assert!(!text.contains("-1.00000"), "{text}");
+        assert!(
+            text.contains("piston.x: neutral (rigid-body or integrator"),
+            "{text}"
+        );
+        assert!(!text.contains("grow"), "{text}");
+        let json = report.json(3);
+        assert!(json.contains("\"label\": \"spool1.y\""), "{json}");
+        assert!(json.contains("\"neutral\": true"), "{json}");
+        assert!(json.contains("\"damping_ratio\": null"), "{json}");
+        // every state taken: numbered
+        let mut more = report;
+        more.modes.push(mode(-5.0, vec![(2, 1.0)]));
+        assert_eq!(more.labels()[3], "piston.x #2");
     }
 }

@@ -143,10 +143,21 @@ fn font() -> Result<(), PlotError> {
     }
 }
 
-/// A tick label with three significant digits and no trailing zeros (0.3, 12, 0.0025).
+/// A tick label with three significant digits and no trailing zeros (0.3, 12, 0.0025);
+/// beyond 1e15 in powers of ten (2.5e20), not in 21 digits.
 fn significant(v: f64) -> String {
     if v == 0.0 || !v.is_finite() {
         return format!("{v}");
+    }
+    if v.abs() >= 1e15 {
+        let s = format!("{v:.2e}");
+        let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
+        let m = if m.contains('.') {
+            m.trim_end_matches('0').trim_end_matches('.')
+        } else {
+            m
+        };
+        return format!("{m}e{e}");
     }
     let digits = (2 - v.abs().log10().floor() as i32).max(0) as usize;
     let s = format!("{v:.digits$}");
@@ -155,6 +166,39 @@ fn significant(v: f64) -> String {
     } else {
         s
     }
+}
+
+/// The largest magnitude an axis end may have, so that the axis span, its padding and its
+/// ticks stay finite: plotters loops forever over an infinite span (1e308 and −1e308 in one
+/// column), and f64 holds no span of ±1.8e308.
+const AXIS_LIMIT: f64 = 1e306;
+
+/// An axis range plotters can draw from `lo..hi`: both ends finite and within
+/// ±[`AXIS_LIMIT`], `lo < hi` by more than f64 resolves there. A range that already is one
+/// is returned unchanged; a non-finite or reversed one becomes 0..1; a span too small
+/// to resolve is widened around its middle.
+fn axis(lo: f64, hi: f64) -> (f64, f64) {
+    if !(lo.is_finite() && hi.is_finite()) || lo > hi {
+        return (0.0, 1.0);
+    }
+    let (lo, hi) = (
+        lo.clamp(-AXIS_LIMIT, AXIS_LIMIT),
+        hi.clamp(-AXIS_LIMIT, AXIS_LIMIT),
+    );
+    let size = lo.abs().max(hi.abs());
+    if hi - lo > 1e-12 * size.max(1e-300) {
+        return (lo, hi);
+    }
+    let pad = 0.5 * size.max(1e-9);
+    (lo - pad, hi + pad)
+}
+
+/// `v` drawn on an axis `lo..hi`: values far outside it are brought to one span beyond
+/// its ends (still outside the chart, so clipped), so that no pixel coordinate overflows
+/// and no line is rasterised over billions of pixels.
+fn on_axis(v: f64, (lo, hi): (f64, f64)) -> f64 {
+    let span = hi - lo;
+    v.clamp(lo - span, hi + span)
 }
 
 const PALETTE: [RGBColor; 6] = [

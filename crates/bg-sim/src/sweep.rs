@@ -115,10 +115,27 @@ pub fn sweep(
     opts: &Options,
 ) -> Result<Summary, SweepError> {
     let file = model_path.display().to_string();
+    // the model must load as written: a mistake common to every run is an error, not N
+    // rows; read as the loader reads (a FIFO or a directory refused, not waited on)
+    Model::load(model_path, &registry(), &[]).map_err(|e| {
+        let m = e.to_string();
+        let m = m
+            .strip_prefix(&format!("{file}: "))
+            .map_or(m.clone(), str::to_owned);
+        err(&file, m)
+    })?;
     let text = fs::read_to_string(model_path)
         .map_err(|e| err(&file, format!("cannot read the model: {e}")))?;
-    // the model must load as written: a mistake common to every run is an error, not N rows
-    Model::from_text(&file, &text, &registry(), &[]).map_err(|e| err(&file, e.to_string()))?;
+    // a spec parameter the model lacks is a mistake common to every run (issue 24, item 8):
+    // the path is checked once, with any value, before a run starts
+    for (path, _) in &spec.parameters {
+        bg_model::overrides::apply(&file, &text, &[format!("{path}=0")]).map_err(|e| {
+            err(
+                &file,
+                format!("the sweep's parameter `{path}` is not in the model, so no run could use it: {e}"),
+            )
+        })?;
+    }
     let all = points(spec);
     fs::create_dir_all(&opts.out_dir).map_err(|e| {
         err(

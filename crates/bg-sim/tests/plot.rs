@@ -303,3 +303,66 @@ fn every_model_runs_with_its_plots_and_its_csv_can_be_looked_at() {
     }
     assert!(n >= 7, "only {n} models");
 }
+
+/// Run `cmd`, killing it after `secs` seconds: `None` if it had to be killed (a hang).
+fn within(cmd: &mut Command, secs: u64) -> Option<std::process::Output> {
+    let mut child = cmd
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while start.elapsed().as_secs() < secs {
+        if child.try_wait().unwrap().is_some() {
+            return Some(child.wait_with_output().unwrap());
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    None
+}
+
+/// Issue 24, item 6: a column (or the t column) holding 1e308 and −1e308 has a range no f64
+/// holds; plotters looped forever over it. Now each such figure is drawn (the axis held
+/// within ±1e306, the values beyond it at its edge), as are columns of NaN, ±inf and a
+/// single repeated ±1e308.
+#[test]
+fn plot_of_ranges_that_overflow_f64_is_drawn_not_a_hang() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        ("y", "t,y\n0,1e308\n1,-1e308\n2,0\n"),
+        ("t", "t,y\n1e308,1\n-1e308,2\n0,3\n"),
+        ("both", "t,y\n-1e308,1e308\n1e308,-1e308\n"),
+        ("nonfinite", "t,y\n0,NaN\n1,inf\n2,-inf\n"),
+        ("huge_constant", "t,y\n1e308,1.7e308\n1e308,1.7e308\n"),
+        ("tiny", "t,y\n0,5e-324\n1e-320,-5e-324\n"),
+    ];
+    for (name, text) in cases {
+        let csv = dir.path().join(format!("{name}.csv"));
+        std::fs::write(&csv, text).unwrap();
+        let out = dir.path().join(name);
+        let o = within(
+            bg_sim()
+                .arg("plot")
+                .arg(&csv)
+                .args(["--columns", "y", "--format", "both", "-o"])
+                .arg(&out),
+            60,
+        )
+        .unwrap_or_else(|| panic!("{name}: `bg-sim plot` still running after 60 s"));
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{name}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(is_png(&out.join(format!("{name}.png"))), "{name}");
+        let svg = std::fs::read_to_string(out.join(format!("{name}.svg"))).unwrap();
+        assert!(
+            svg.len() < 2_000_000,
+            "{name}: an SVG of {} bytes",
+            svg.len()
+        );
+    }
+}

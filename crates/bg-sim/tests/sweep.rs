@@ -348,3 +348,62 @@ fn an_interrupted_sweep_resumes_where_it_stopped() {
     );
     assert_eq!(read_summary(&summary).unwrap().1.len(), 20);
 }
+
+/// Issue 24, item 8: a parameter the model lacks is a mistake common to every run: exit 2
+/// before any run (no summary written), naming it, as docs/sweeps.md says; before, every
+/// run was an error row and the exit status 1. A spec's mistakes name its file and line.
+#[test]
+fn a_spec_mistake_is_exit_2_before_any_run_and_names_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let spec = dir.path().join("spec.toml");
+    std::fs::write(
+        &spec,
+        "[parameters]\nm = [1.0, 2.0]\nnope = [1.0, 2.0]\n[metrics]\nx_end = \"final(x)\"\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_bg-sim"))
+        .arg("sweep")
+        .arg(model("mass_spring_damper"))
+        .arg("--spec")
+        .arg(&spec)
+        .arg("-o")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("parameters.nope") && err.contains("no parameter `nope`"),
+        "{err}"
+    );
+    assert!(!out.join("summary.csv").exists(), "a run started");
+    // spec errors: file and line
+    for (text, line, what) in [
+        (
+            "[parameters]\nm = [1.0]\nk = { from = nan, to = 1.0, n = 2 }\n",
+            3,
+            "`k`: `from` must be a finite number",
+        ),
+        (
+            "[sweep]\ndesign = \"grid\"\nkeep_runs = 3\n[parameters]\nm = [1.0]\n",
+            3,
+            "keep_runs is true or false",
+        ),
+        (
+            "[parameters]\nm = [1.0]\n[metrics]\n\n\"peak\" = \"biggest(x)\"\n",
+            5,
+            "peak",
+        ),
+        (
+            "[parameters]\nm = [1.0]\nk = { from = 1.0, to = 2.0 }\n",
+            3,
+            "needs n",
+        ),
+        ("[parameters]\nm = [1.0\n", 2, "not a valid TOML"),
+    ] {
+        let e = parse_spec("spec.toml", text).unwrap_err().to_string();
+        assert!(e.starts_with(&format!("spec.toml:{line}: ")), "{text}: {e}");
+        assert!(e.contains(what), "{e}");
+    }
+}

@@ -15,6 +15,20 @@
 //! r_i/s_i is therefore the change of unknowns, in their scales, still needed; the solve
 //! stops when every scaled residual is below `tol`.
 //!
+//! **Each condition in its own scale.** A row whose unknowns move it little next to the
+//! terms it sums (a hose's pressure rate: a pump flow in, nearly as much out, a small leak
+//! set by the pressure) has a rounding floor above `tol` in the scaled measure: Newton
+//! converges and then cannot reduce the residual further. So when Newton stalls, each
+//! condition is judged in its own scale too ([`Settle`]): a rate condition on a state is
+//! met when the residual would move that state by less than its error weight
+//! (`atol + rtol·|x|`, the integrator's own) over the whole run; a state condition when it
+//! is within that weight; a variable condition when it is within
+//! `atol + rtol·max(|v|, |value|)` (each times [`OWN_SCALE_FRACTION`], 1). A start accepted
+//! so drifts by less over the run than the integrator resolves in one step; the conditions
+//! so judged are listed ([`Equilibrium::own_scale`]). The crane's full rest asked for
+//! tol = 1e-16 stalls with its arm's momentum rates at 5e-11 N·m, 0.1 of their own scale. A converged solve is judged as before, so a start that
+//! solved before is unchanged to the bit.
+//!
 //! A system without an equilibrium is refused ([`EquilibriumError`]): the counts differ, a
 //! condition depends on no unknown, the scaled Jacobian is singular (the unknowns of its
 //! null direction are named), or the line search cannot reduce the residuals (the largest
@@ -53,6 +67,40 @@ pub enum Condition {
     },
 }
 
+/// The fraction of a condition's own scale within which it is met when Newton stalls at
+/// its rounding floor (see the module notes): 1, a drift over the run of at most one error
+/// weight.
+pub const OWN_SCALE_FRACTION: f64 = 1.0;
+
+/// What a condition's own scale is made of: the integrator's tolerances and the span of the
+/// run the start must stay steady over.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settle {
+    /// Absolute tolerance of the states.
+    pub atol: f64,
+    /// Relative tolerance of the states.
+    pub rtol: f64,
+    /// The time the start must stay steady over (`t_end − t_start`), s.
+    pub span: f64,
+}
+
+impl Settle {
+    /// The largest residual of `c` met in its own scale at `x`, where the condition's
+    /// variable reads `v` (the state, or the variable for [`Condition::Variable`]).
+    #[must_use]
+    pub fn tolerance(&self, c: &Condition, x: &[f64], v: f64) -> f64 {
+        let weight = |state: usize| self.atol + self.rtol * x.get(state).map_or(0.0, |x| x.abs());
+        OWN_SCALE_FRACTION
+            * match c {
+                Condition::Derivative { state, .. } => weight(*state) / self.span,
+                Condition::State { state, .. } => weight(*state),
+                Condition::Variable { value, .. } => {
+                    self.atol + self.rtol * v.abs().max(value.abs())
+                }
+            }
+    }
+}
+
 /// A steady-state request: the unknown states and as many conditions.
 #[derive(Clone, Debug)]
 pub struct SteadyRequest {
@@ -64,6 +112,9 @@ pub struct SteadyRequest {
     pub tol: f64,
     /// Most Newton iterations (default 50).
     pub max_iterations: usize,
+    /// Each condition's own scale, for judging a solve that stalls at its rounding floor
+    /// (default none: every condition is judged by `tol` in the scaled measure alone).
+    pub settle: Option<Settle>,
 }
 
 impl SteadyRequest {
@@ -75,6 +126,7 @@ impl SteadyRequest {
             conditions,
             tol: 1e-10,
             max_iterations: 50,
+            settle: None,
         }
     }
 }
@@ -89,6 +141,10 @@ pub struct Equilibrium {
     /// Per condition: its name (`mass.p.dot = 0`), the residual in the condition's units, and
     /// scaled by its row scale.
     pub residuals: Vec<(String, f64, f64)>,
+    /// The conditions met in their own scale only ([`Settle`]), not by `tol` in the scaled
+    /// measure: name, residual, the largest residual their own scale accepts. Empty when
+    /// the solve converged in the scaled measure.
+    pub own_scale: Vec<(String, f64, f64)>,
 }
 
 impl Equilibrium {
@@ -272,6 +328,38 @@ impl Problem<'_> {
         out
     }
 
+    /// A stalled solve judged per condition in its own scale (see the module notes): the
+    /// equilibrium if every condition is met by `tol` in the scaled measure or within its
+    /// own scale ([`Settle::tolerance`]).
+    fn settled(&mut self, x: Vec<f64>, r: &[f64], iterations: usize) -> Option<Equilibrium> {
+        let settle = self.req.settle?;
+        if r.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        let s = self.scaled(r);
+        let mut own_scale = Vec::new();
+        for (i, c) in self.req.conditions.iter().enumerate() {
+            if s[i].abs() <= self.req.tol {
+                continue;
+            }
+            let v = match c {
+                Condition::Variable { value, .. } => r[i] + value,
+                Condition::Derivative { state, .. } | Condition::State { state, .. } => x[*state],
+            };
+            let tol = settle.tolerance(c, &x, v);
+            if tol.is_nan() || r[i].abs() > tol {
+                return None;
+            }
+            own_scale.push((condition_name(self.eqs, c), r[i], tol));
+        }
+        Some(Equilibrium {
+            residuals: self.report(r, false),
+            x,
+            iterations,
+            own_scale,
+        })
+    }
+
     fn names(&self) -> Vec<String> {
         self.req
             .unknowns
@@ -344,6 +432,7 @@ pub fn solve_steady(
             x,
             iterations: 0,
             residuals: Vec::new(),
+            own_scale: Vec::new(),
         });
     }
     let mut p = Problem {
@@ -392,6 +481,7 @@ pub fn solve_steady(
                 x,
                 iterations: it,
                 residuals,
+                own_scale: Vec::new(),
             });
         }
         if it == req.max_iterations || !worst.is_finite() {
@@ -459,19 +549,23 @@ pub fn solve_steady(
                 r = rt;
             }
             None => {
-                return Err(EquilibriumError::NoEquilibrium {
-                    unknowns: p.names(),
-                    iterations: it + 1,
-                    residuals: p.report(&r, true),
-                })
+                return p
+                    .settled(x, &r, it + 1)
+                    .ok_or_else(|| EquilibriumError::NoEquilibrium {
+                        unknowns: p.names(),
+                        iterations: it + 1,
+                        residuals: p.report(&r, true),
+                    })
             }
         }
     }
-    Err(EquilibriumError::NoEquilibrium {
-        unknowns: p.names(),
-        iterations: req.max_iterations,
-        residuals: p.report(&r, true),
-    })
+    let residuals = p.report(&r, true);
+    p.settled(x, &r, req.max_iterations)
+        .ok_or_else(|| EquilibriumError::NoEquilibrium {
+            unknowns: p.names(),
+            iterations: req.max_iterations,
+            residuals,
+        })
 }
 
 #[cfg(test)]
@@ -616,5 +710,81 @@ mod tests {
         };
         assert!(!unknowns.is_empty(), "{e}");
         assert!(e.to_string().contains("mass.p.dot = 0"), "{e}");
+    }
+
+    /// Each condition's own scale (issue 24, item 1): a rate by the state's error weight
+    /// per span, a state by its weight, a variable by atol + rtol·max(|v|, |value|), each
+    /// times OWN_SCALE_FRACTION; a pressure rate (Pa/s, p = 2e7) and a momentum rate (N,
+    /// p = 0) get tolerances eleven orders apart, each in its own units.
+    #[test]
+    fn each_condition_has_its_own_scale() {
+        let settle = Settle {
+            atol: 1e-8,
+            rtol: 1e-6,
+            span: 20.0,
+        };
+        let x = [2e7, 0.0];
+        let rate = |state| Condition::Derivative { state, value: 0.0 };
+        let pressure = settle.tolerance(&rate(0), &x, x[0]);
+        let momentum = settle.tolerance(&rate(1), &x, x[1]);
+        let f = OWN_SCALE_FRACTION;
+        assert!(
+            (pressure - f * (1e-8 + 20.0) / 20.0).abs() < 1e-12 * pressure,
+            "{pressure}"
+        );
+        assert!(
+            (momentum - f * 1e-8 / 20.0).abs() < 1e-12 * momentum,
+            "{momentum}"
+        );
+        let state = settle.tolerance(
+            &Condition::State {
+                state: 0,
+                value: 2e7,
+            },
+            &x,
+            x[0],
+        );
+        assert!((state - f * (1e-8 + 20.0)).abs() < 1e-12 * state, "{state}");
+    }
+
+    /// A solve that cannot reach `tol` (here: 1e-30, below any rounding floor) is refused
+    /// without [`Settle`], and accepted with it when every residual is within its own
+    /// scale, the conditions so judged listed; tolerances below the floor still refuse it.
+    #[test]
+    fn a_stalled_solve_is_judged_in_each_conditions_own_scale() {
+        let eqs = hanging(-98.1, 5e4);
+        let (q, p) = (index(&eqs, "spring.q"), index(&eqs, "mass.p"));
+        let mut req = SteadyRequest::new(
+            vec![q],
+            vec![Condition::Derivative {
+                state: p,
+                value: 0.0,
+            }],
+        );
+        req.tol = 1e-30;
+        req.max_iterations = 3;
+        let x0 = eqs.initial_state();
+        // a non-zero residual: start off the solution so rounding is left
+        let mut start = x0.clone();
+        start[q] = 1e-3;
+        match solve_steady(&eqs, 0.0, &start, &req) {
+            Err(e) => assert!(e.to_string().contains("mass.p.dot = 0"), "{e}"),
+            Ok(eq) => assert!(eq.residuals[0].1 == 0.0, "{:?}", eq.residuals),
+        }
+        req.settle = Some(Settle {
+            atol: 1e-8,
+            rtol: 1e-6,
+            span: 10.0,
+        });
+        let eq = solve_steady(&eqs, 0.0, &start, &req).unwrap();
+        assert!((eq.x[q] + 98.1 / 5e4).abs() < 1e-12, "{}", eq.x[q]);
+        for (name, r, tol) in &eq.own_scale {
+            assert_eq!(name, "mass.p.dot = 0");
+            let want = OWN_SCALE_FRACTION * 1e-8 / 10.0;
+            assert!(
+                r.abs() <= *tol && (*tol - want).abs() <= 1e-12 * want,
+                "{r} {tol}"
+            );
+        }
     }
 }

@@ -101,7 +101,10 @@ pub use element::{
 };
 pub use elements::*;
 pub use equations::{Probe, StateEquations, StateInfo};
-pub use equilibrium::{solve_steady, Condition, Equilibrium, EquilibriumError, SteadyRequest};
+pub use equilibrium::{
+    solve_steady, Condition, Equilibrium, EquilibriumError, Settle, SteadyRequest,
+    OWN_SCALE_FRACTION,
+};
 pub use error::{CausalityError, Error, GraphError, ParamError, SimulationError};
 pub use graph::{BondGraph, Node};
 pub use kind::{BuildError, Composite, KindDecl, ParamDecl, Params};

@@ -23,7 +23,7 @@
 //! 3 on, `x.q[1..3]` components 1 and 2. Condition values are constant expressions of the
 //! parameters.
 
-use bondgraph::{solve_steady, Condition, Equilibrium, StateEquations, SteadyRequest};
+use bondgraph::{solve_steady, Condition, Equilibrium, Settle, StateEquations, SteadyRequest};
 use indexmap::IndexMap;
 
 use crate::expr::Expr;
@@ -55,6 +55,19 @@ impl std::fmt::Display for SteadyReport {
         )?;
         if let Some((c, r, s)) = self.solution.worst() {
             write!(f, "; largest residual {r:.3e} ({c}; scaled {s:.1e})")?;
+        }
+        if !self.solution.own_scale.is_empty() {
+            let judged: Vec<String> = self
+                .solution
+                .own_scale
+                .iter()
+                .map(|(c, r, tol)| format!("{c}: {r:.3e}, within {tol:.1e}"))
+                .collect();
+            write!(
+                f,
+                "; judged in their own scale (Newton stalled at rounding; atol + rtol·|x|, a rate over the run's span): {}",
+                judged.join(", ")
+            )?;
         }
         if self.kept.len() < self.unknowns.len() {
             write!(f, "; the start takes {}", self.kept.join(", "))?;
@@ -274,13 +287,15 @@ fn conditions(
 }
 
 /// Solve the `[initial.steady]` request in `value` at time `t` from `x0`; `Ok(None)` when
-/// the request is `use = "none"`.
+/// the request is `use = "none"`. `settle`: the run's tolerances and span, each condition's
+/// own scale should Newton stall at rounding ([`Settle`]).
 pub(crate) fn solve(
     value: &toml::Value,
     eqs: &StateEquations,
     parameters: &IndexMap<String, f64>,
     t: f64,
     x0: &[f64],
+    settle: Settle,
 ) -> Result<Option<SteadyReport>, Problem> {
     let Some(spec) = read(value)? else {
         return Ok(None);
@@ -317,6 +332,7 @@ pub(crate) fn solve(
         }
     };
     let mut req = SteadyRequest::new(unknowns.clone(), conds);
+    req.settle = Some(settle);
     if let Some(tol) = spec.tol {
         req.tol = tol;
     }

@@ -38,9 +38,19 @@ fn compare(
         return ExitCode::from(2);
     };
     let scored = bg_sim::bench::Reference::read(reference, columns, &floors).and_then(|r| {
-        let run = Results::read(results)
-            .map_err(|e| e.to_string())?
-            .to_trajectory();
+        let table = Results::read(results).map_err(|e| e.to_string())?;
+        bg_sim::bench::unscorable(reference, &r, |name| {
+            if name == "t" {
+                Some(r.t.as_slice())
+            } else {
+                r.columns
+                    .iter()
+                    .find(|c| c.0 == name)
+                    .map(|c| c.1.as_slice())
+            }
+        })?;
+        bg_sim::bench::unscorable(results, &r, |name| table.column(name))?;
+        let run = table.to_trajectory();
         let errors = r.errors(&run).ok_or_else(|| {
             format!(
                 "{} does not cover the time span of {} or lacks one of its columns",
@@ -48,6 +58,11 @@ fn compare(
                 reference.display()
             )
         })?;
+        if let Some((name, e)) = errors.iter().find(|(_, e)| !e.is_finite()) {
+            return Err(format!(
+                "the error of column `{name}` is {e}: the comparison cannot be scored"
+            ));
+        }
         Ok((r, errors))
     });
     match scored {

@@ -8,8 +8,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::{
-    font, significant, Format, PlotError, Results, FIG_LEGEND_WIDTH, FIG_WIDTH, FONT, PALETTE,
-    PANEL_HEIGHT, TITLE_HEIGHT,
+    axis, font, on_axis, significant, Format, PlotError, Results, FIG_LEGEND_WIDTH, FIG_WIDTH,
+    FONT, PALETTE, PANEL_HEIGHT, TITLE_HEIGHT,
 };
 
 /// Draw every plot of `plots` (a model's `[[plot]]` tables; `model` names the file in
@@ -97,13 +97,15 @@ fn y_range(curves: &[Vec<(f64, f64)>]) -> (f64, f64) {
     if !lo.is_finite() {
         return (-1.0, 1.0);
     }
+    // within what an axis can hold: the span of ±1e308 is no f64
+    let (lo, hi) = axis(lo, hi);
     let span = hi - lo;
     let pad = if span > 1e-12 * lo.abs().max(hi.abs()).max(1e-300) {
         0.05 * span
     } else {
         0.5 * lo.abs().max(1e-9)
     };
-    (lo - pad, hi + pad)
+    axis(lo - pad, hi + pad)
 }
 
 /// A tick label on an axis spanning `span`: a value that is zero but for rounding (2e-17
@@ -176,6 +178,8 @@ fn draw_panel<DB: DrawingBackend>(
         (x0, x1) = (x0.max(a), x1.min(b));
     }
     let x1 = x1.max(x0 + 1e-12);
+    // an axis plotters can draw (a t column of ±1e308 has no finite span)
+    let (x0, x1) = axis(x0, x1);
     let curves: Vec<Vec<(f64, f64)>> = panel
         .series
         .iter()
@@ -190,6 +194,14 @@ fn draw_panel<DB: DrawingBackend>(
         })
         .collect();
     let (y0, y1) = y_range(&curves);
+    let curves: Vec<Vec<(f64, f64)>> = curves
+        .into_iter()
+        .map(|pts| {
+            pts.into_iter()
+                .map(|(x, y)| (x, on_axis(y, (y0, y1))))
+                .collect()
+        })
+        .collect();
     let width = area.dim_in_pixel().0;
     // the legend sits right of the chart, so it never hides a curve
     let (plot_area, legend_area) = area.split_horizontally(width.saturating_sub(FIG_LEGEND_WIDTH));

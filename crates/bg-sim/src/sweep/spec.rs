@@ -121,75 +121,140 @@ pub struct Spec {
     pub keep_runs: bool,
 }
 
-/// Parse a sweep spec; `file` names it in errors.
+/// Parse a sweep spec; `file` names it in errors, with the line of the key at fault
+/// (`spec.toml:7`) where there is one.
 pub fn parse_spec(file: &str, text: &str) -> Result<Spec, SweepError> {
+    parse(file, text).map_err(|(key, mut e)| {
+        if let Some(line) = key.and_then(|(section, k)| line_of(text, section, &k)) {
+            e.file = format!("{file}:{line}");
+        }
+        e
+    })
+}
+
+/// The 1-based line of `key` in `[section]` of a TOML `text` (bare or quoted, before `=`).
+fn line_of(text: &str, section: &str, key: &str) -> Option<usize> {
+    let mut current = String::new();
+    for (i, line) in text.lines().enumerate() {
+        let l = line.trim();
+        if let Some(h) = l.strip_prefix('[') {
+            current = h.split(']').next().unwrap_or("").trim().to_owned();
+            continue;
+        }
+        if current != section {
+            continue;
+        }
+        let Some((k, _)) = l.split_once('=') else {
+            continue;
+        };
+        let k = k.trim();
+        if k == key || k.trim_matches('"') == key || k.trim_matches('\'') == key {
+            return Some(i + 1);
+        }
+    }
+    None
+}
+
+/// The key an error is about: its section and name.
+type At = Option<(&'static str, String)>;
+
+fn parse(file: &str, text: &str) -> Result<Spec, (At, SweepError)> {
+    let at = |section: &'static str, key: &str| {
+        let key = key.to_owned();
+        move |e: SweepError| (Some((section, key)), e)
+    };
+    let nowhere = |e: SweepError| (None, e);
     let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
-        err(
-            file,
+        let line = e
+            .span()
+            .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+        let file = line.map_or_else(|| file.to_owned(), |l| format!("{file}:{l}"));
+        nowhere(err(
+            &file,
             format!("not a valid TOML sweep spec: {}", e.message()),
-        )
+        ))
     })?;
     for key in table.keys() {
         if !["sweep", "parameters", "metrics"].contains(&key.as_str()) {
-            return Err(err(
+            return Err(nowhere(err(
                 file,
                 format!(
                     "unknown section `{key}`; a sweep spec has [sweep], [parameters] and [metrics]"
                 ),
-            ));
+            )));
         }
     }
     let sweep = match table.get("sweep") {
         None => toml::Table::new(),
         Some(toml::Value::Table(t)) => t.clone(),
-        Some(_) => return Err(err(file, "`sweep` must be a table")),
+        Some(_) => return Err(nowhere(err(file, "`sweep` must be a table"))),
     };
-    let int = |k: &str| -> Result<Option<u64>, SweepError> {
+    let int = |k: &str| -> Result<Option<u64>, (At, SweepError)> {
         match sweep.get(k) {
             None => Ok(None),
             Some(toml::Value::Integer(i)) if *i >= 0 => Ok(u64::try_from(*i).ok()),
-            Some(_) => Err(err(file, format!("[sweep] {k} must be a whole number ≥ 0"))),
+            Some(_) => Err(at("sweep", k)(err(
+                file,
+                format!("[sweep] {k} must be a whole number ≥ 0"),
+            ))),
         }
     };
     for k in sweep.keys() {
         if !["design", "samples", "seed", "keep_runs"].contains(&k.as_str()) {
-            return Err(err(
+            return Err(at("sweep", k)(err(
                 file,
                 format!("[sweep] has no key `{k}`; keys: design, samples, seed, keep_runs"),
-            ));
+            )));
         }
     }
     let design = match sweep.get("design").map(toml::Value::as_str) {
         None | Some(Some("grid")) => {
             if sweep.contains_key("samples") {
-                return Err(err(file, "[sweep] samples is for design = \"lhs\""));
+                return Err(at("sweep", "samples")(err(
+                    file,
+                    "[sweep] samples is for design = \"lhs\"",
+                )));
             }
             Design::Grid
         }
         Some(Some("lhs")) => {
-            let samples =
-                int("samples")?.ok_or_else(|| err(file, "design = \"lhs\" needs samples = N"))?;
+            let samples = int("samples")?.ok_or_else(|| {
+                at("sweep", "design")(err(file, "design = \"lhs\" needs samples = N"))
+            })?;
             let samples = usize::try_from(samples).unwrap_or(usize::MAX);
             if samples == 0 || samples > MAX_RUNS {
-                return Err(err(file, format!("samples must be 1 to {MAX_RUNS}")));
+                return Err(at("sweep", "samples")(err(
+                    file,
+                    format!("samples must be 1 to {MAX_RUNS}"),
+                )));
             }
             Design::Lhs {
                 samples,
                 seed: int("seed")?.unwrap_or(0),
             }
         }
-        Some(_) => return Err(err(file, "[sweep] design is \"grid\" or \"lhs\"")),
+        Some(_) => {
+            return Err(at("sweep", "design")(err(
+                file,
+                "[sweep] design is \"grid\" or \"lhs\"",
+            )))
+        }
     };
     let keep_runs = match sweep.get("keep_runs") {
         None => false,
         Some(toml::Value::Boolean(b)) => *b,
-        Some(_) => return Err(err(file, "[sweep] keep_runs is true or false")),
+        Some(_) => {
+            return Err(at("sweep", "keep_runs")(err(
+                file,
+                "[sweep] keep_runs is true or false",
+            )))
+        }
     };
 
     let mut parameters = Vec::new();
     if let Some(p) = table.get("parameters") {
         let toml::Value::Table(p) = p else {
-            return Err(err(file, "`parameters` must be a table"));
+            return Err(nowhere(err(file, "`parameters` must be a table")));
         };
         for (name, v) in p {
             let path = if name.contains('.') {
@@ -197,29 +262,32 @@ pub fn parse_spec(file: &str, text: &str) -> Result<Spec, SweepError> {
             } else {
                 format!("parameters.{name}")
             };
-            parameters.push((path, parse_values(file, name, v)?));
+            parameters.push((
+                path,
+                parse_values(file, name, v).map_err(at("parameters", name))?,
+            ));
         }
     }
     if parameters.is_empty() {
-        return Err(err(
+        return Err(nowhere(err(
             file,
             "[parameters] is empty: name at least one value to sweep (k = [1.0, 2.0])",
-        ));
+        )));
     }
 
     let mut metrics = Vec::new();
     if let Some(m) = table.get("metrics") {
         let toml::Value::Table(m) = m else {
-            return Err(err(file, "`metrics` must be a table"));
+            return Err(nowhere(err(file, "`metrics` must be a table")));
         };
         for (name, v) in m {
             let Some(src) = v.as_str() else {
-                return Err(err(
+                return Err(at("metrics", name)(err(
                     file,
                     format!("metric `{name}` must be a string such as \"max(x)\""),
-                ));
+                )));
             };
-            metrics.push(parse_metric(name, src).map_err(|m| err(file, m))?);
+            metrics.push(parse_metric(name, src).map_err(|m| at("metrics", name)(err(file, m)))?);
         }
     }
     if design == Design::Grid {
@@ -227,10 +295,11 @@ pub fn parse_spec(file: &str, text: &str) -> Result<Spec, SweepError> {
             .iter()
             .find(|(_, v)| matches!(v, Values::Range { n: 0, .. }))
         {
-            return Err(err(
+            let name = k.strip_prefix("parameters.").unwrap_or(k);
+            return Err(at("parameters", name)(err(
                 file,
                 format!("`{k}`: a range in a grid needs n, the number of values"),
-            ));
+            )));
         }
     }
     let spec = Spec {
@@ -241,10 +310,10 @@ pub fn parse_spec(file: &str, text: &str) -> Result<Spec, SweepError> {
     };
     let n = run_count(&spec);
     if n > MAX_RUNS {
-        return Err(err(
+        return Err(nowhere(err(
             file,
             format!("the grid has {n} runs, more than {MAX_RUNS}; use design = \"lhs\""),
-        ));
+        )));
     }
     Ok(spec)
 }

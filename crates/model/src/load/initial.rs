@@ -97,7 +97,13 @@ pub(super) fn steady(
     eqs: &mut StateEquations,
 ) -> Result<Option<crate::steady::SteadyReport>, ModelError> {
     let x0 = eqs.initial_state();
-    let report = crate::steady::solve(v.get_ref(), eqs, parameters, settings.t_start, &x0)
+    // each condition's own scale: the run's tolerances over its span (issue 24, item 1)
+    let settle = bondgraph::Settle {
+        atol: settings.atol,
+        rtol: settings.rtol,
+        span: settings.t_end - settings.t_start,
+    };
+    let report = crate::steady::solve(v.get_ref(), eqs, parameters, settings.t_start, &x0, settle)
         .map_err(|(message, hint)| {
             source
                 .err(ErrorKind::Settings, Some(&v.span()), message)

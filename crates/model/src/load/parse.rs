@@ -149,6 +149,37 @@ pub(super) fn read_model(path: &Path, file: &str) -> Result<String, ModelError> 
     let io = |e: std::io::Error| {
         ModelError::new(ErrorKind::Io, file, format!("cannot read: {e}")).hint("check the path")
     };
+    // a FIFO without a writer blocks `open` for ever, and a directory is no model: both are
+    // refused before opening (issue 24, item 10); devices such as /dev/zero are read, bounded
+    if let Ok(meta) = std::fs::metadata(path) {
+        let kind = meta.file_type();
+        #[cfg(unix)]
+        let special = {
+            use std::os::unix::fs::FileTypeExt;
+            if kind.is_fifo() {
+                Some("a FIFO (named pipe)")
+            } else if kind.is_socket() {
+                Some("a socket")
+            } else {
+                None
+            }
+        };
+        #[cfg(not(unix))]
+        let special: Option<&str> = None;
+        let what = if kind.is_dir() {
+            Some("a directory")
+        } else {
+            special
+        };
+        if let Some(what) = what {
+            return Err(ModelError::new(
+                ErrorKind::Io,
+                file,
+                format!("cannot read: it is {what}, not a model file"),
+            )
+            .hint("give the path of a model's .toml file (write piped text to a file first)"));
+        }
+    }
     let mut bytes = Vec::new();
     std::fs::File::open(path)
         .and_then(|f| f.take(MAX_FILE_BYTES as u64 + 1).read_to_end(&mut bytes))
@@ -231,6 +262,7 @@ pub(super) fn parse(
         plots: Vec::new(),
         inputs: Vec::new(),
         tables: std::sync::Arc::default(),
+        line_starts: super::source::line_starts(&text),
     };
     let mut problems = Vec::new();
     let mut failed = Failed::default();
