@@ -66,7 +66,11 @@ const VALVES: &[(&str, &[&str], &str)] = &[
         "q_set = X, dp_comp = 1e6, g_leak = 1e-13",
     ),
     // the load-sensing network (docs/hydraulics.md, "Load sensing")
-    ("hydraulics.shuttle_valve", &["a", "b", "out"], "alpha = 5e-7"),
+    (
+        "hydraulics.shuttle_valve",
+        &["a", "b", "out"],
+        "alpha = 5e-7",
+    ),
     (
         "hydraulics.ls_section",
         &["P", "T", "A", "B", "LS"],

@@ -28,13 +28,19 @@ pub const KIND: KindDecl = KindDecl::composite(
     "LS signal line: a volume with an orifice bleed to tank, q_bleed at dp_bleed; port p",
     &[
         ParamDecl::number("volume", "m³", "volume of the signal line").positive(),
-        ParamDecl::number("beta", "Pa", "bulk modulus").positive().default(1.5e9),
+        ParamDecl::number("beta", "Pa", "bulk modulus")
+            .positive()
+            .default(1.5e9),
         ParamDecl::number("q_bleed", "m³/s", "bleed flow at dp_bleed (\"0.2 L/min\")")
             .positive()
             .default(3.333_333e-6),
-        ParamDecl::number("dp_bleed", "Pa", "pressure at which the bleed passes q_bleed")
-            .positive()
-            .default(2e6),
+        ParamDecl::number(
+            "dp_bleed",
+            "Pa",
+            "pressure at which the bleed passes q_bleed",
+        )
+        .positive()
+        .default(2e6),
         ParamDecl::number("p_t", "Pa", "tank pressure").default(0.0),
         ParamDecl::number("p0", "Pa", "initial pressure").default(0.0),
         orifice::P_TR,

@@ -10,12 +10,16 @@
 //! and Motors*, 2001, the LS and pressure controllers):
 //!
 //! ```text
-//! τ·dε/dt = ε* − ε            τ = τ_up while ε* > ε (on-stroke), τ_down otherwise
+//! dε/dt = (ε* − ε)/τ(ε* − ε)   1/τ(d) = ½(1/τ_up + 1/τ_down) + ½(1/τ_up − 1/τ_down)·tanh(d/0.01)
 //! ε* = ramp(ξ_LS)·ramp(ξ_pc)·ramp(ξ_T)                   (crate::ramp: clamp to [0, 1], C¹)
 //! ξ_LS = (P_LS + Δp_LS − P_b)/Δp_band                    LS compensator
 //! ξ_pc = (p_max − P_b)/Δp_cut                            pressure cut-off
 //! ξ_T  = (T_max − ε·D_max·(P_b − P_a))/(0.05·T_max)      torque limiter (optional, else 1)
 //! ```
+//!
+//! The time constant is τ_up on-stroke and τ_down de-stroking (a datasheet's response and
+//! return times), blended over 1 % of the stroke around ε* = ε so that the rate is smooth
+//! where the pump spends its time, at its equilibrium.
 //!
 //! Each spool is proportional: the LS compensator de-strokes the pump fully when the
 //! outlet is Δp_LS above the load-sense pressure (the **margin**, a datasheet's standby
@@ -120,13 +124,16 @@ impl LsController {
         (r1 * r2 * r3, d)
     }
 
-    /// The time constant for target `target` and stroke `eps`.
-    fn tau(&self, target: f64, eps: f64) -> f64 {
-        if target > eps {
-            self.tau_up
-        } else {
-            self.tau_down
-        }
+    /// The stroke rate dε/dt = d/τ(d) at d = ε* − ε, and its slope in d: τ_up on-stroke,
+    /// τ_down de-stroking, blended by tanh over 1 % of the stroke (smooth at ε* = ε).
+    #[must_use]
+    pub fn rate(&self, d: f64) -> (f64, f64) {
+        const BLEND: f64 = 0.01;
+        let a = 0.5 * (1.0 / self.tau_up + 1.0 / self.tau_down);
+        let b = 0.5 * (1.0 / self.tau_up - 1.0 / self.tau_down);
+        let th = (d / BLEND).tanh();
+        let k = a + b * th;
+        (d * k, k + d * b * (1.0 - th * th) / BLEND)
     }
 }
 
@@ -274,7 +281,7 @@ impl Element for LsPump {
     fn derivatives(&self, io: &Io<'_>, dx: &mut [f64]) {
         let eps = io.states()[0];
         let (target, _) = self.target(io);
-        dx[0] = (target - eps) / self.control.tau(target, eps);
+        dx[0] = self.control.rate(target - eps).0;
     }
     fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
         let eps = io.states()[0];
@@ -282,8 +289,7 @@ impl Element for LsPump {
         let omega = self.omega(io);
         let delta = io.e(PA, 0) - io.e(PB, 0);
         // (∂y/∂Δ, ∂y/∂ω, ∂y/∂ε) for y = Q (stage 0) or the pump's torque (stage 1)
-        let (rows, dy_ddelta, dy_domega, dy_deps): (&[(Slot, f64)], f64, f64, f64) = if stage == 0
-        {
+        let (rows, dy_ddelta, dy_domega, dy_deps): (&[(Slot, f64)], f64, f64, f64) = if stage == 0 {
             (
                 &[(Slot::Flow(PA), 1.0), (Slot::Flow(PB), -1.0)],
                 self.machine.leakage(),
@@ -315,12 +321,12 @@ impl Element for LsPump {
     fn derivative_partials(&self, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
         let eps = io.states()[0];
         let (target, d) = self.target(io);
-        let tau = self.control.tau(target, eps);
+        let k = self.control.rate(target - eps).1;
         let row = jac.derivative_row(0);
-        jac.set(row, jac.effort_col(PA, 0), d[0] / tau);
-        jac.set(row, jac.effort_col(PB, 0), d[1] / tau);
-        jac.set(row, jac.effort_col(LS, 0), d[2] / tau);
-        jac.set(row, jac.state_col(0), (d[3] - 1.0) / tau);
+        jac.set(row, jac.effort_col(PA, 0), d[0] * k);
+        jac.set(row, jac.effort_col(PB, 0), d[1] * k);
+        jac.set(row, jac.effort_col(LS, 0), d[2] * k);
+        jac.set(row, jac.state_col(0), (d[3] - 1.0) * k);
         true
     }
 }
@@ -448,10 +454,25 @@ mod tests {
         let t = 0.5 * D * 200e5;
         let c = control(Some(t));
         let e = c.target(D, 0.0, 200e5, 220e5, 0.5).0; // LS and cut-off wide open
-        // exactly at the setting the ramp is at its lower corner: ramp(0) = ε/4
+                                                       // exactly at the setting the ramp is at its lower corner: ramp(0) = ε/4
         assert!((e - 0.05 / 4.0).abs() < 1e-12, "{e}");
         let e = c.target(D, 0.0, 200e5, 220e5, 0.4).0; // below the limit by 20 %: ξ = 4
         assert!((e - 1.0).abs() < 1e-12, "{e}");
+    }
+
+    #[test]
+    fn stroke_rate_uses_each_time_constant_and_is_smooth() {
+        let c = control(None); // τ_up = 40 ms, τ_down = 20 ms
+                               // well away from equilibrium: d/τ_up on-stroke, d/τ_down de-stroking
+        assert!((c.rate(0.5).0 - 0.5 / 0.04).abs() < 1e-9);
+        assert!((c.rate(-0.5).0 + 0.5 / 0.02).abs() < 1e-9);
+        // at equilibrium the mean rate constant, and the slope matches differences
+        assert_eq!(c.rate(0.0).0, 0.0);
+        for d in [-0.02, -0.004, 0.0, 0.003, 0.05] {
+            let h = 1e-7;
+            let fd = (c.rate(d + h).0 - c.rate(d - h).0) / (2.0 * h);
+            assert!((fd - c.rate(d).1).abs() < 1e-5 * fd.abs(), "{d}: {fd}");
+        }
     }
 
     #[test]
@@ -480,6 +501,7 @@ mod tests {
             // on-stroke and de-stroking, and in the torque limiter's band
             for (pb, pls, w, eps) in [
                 (119.4e5, 100e5, 150.0, 0.5),
+                (119.4e5, 100e5, 150.0, 0.3),
                 (247.7e5, 248e5, 150.0, 0.6),
                 (50e5, 40e5, 150.0, 0.95),
                 (121e5, 100e5, -20.0, 0.2),

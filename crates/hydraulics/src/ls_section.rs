@@ -202,7 +202,11 @@ impl LsSection {
     /// X; X unused by a pre-compensator).
     fn edges(&self, x_v: f64, p: &[f64; 6]) -> [EdgeFlow; 7] {
         let x = x_v.clamp(-1.0, 1.0);
-        let inside = if (-1.0..=1.0).contains(&x_v) { 1.0 } else { 0.0 };
+        let inside = if (-1.0..=1.0).contains(&x_v) {
+            1.0
+        } else {
+            0.0
+        };
         // openings and their slopes: at x = 0 the A side takes the slope (right derivative)
         let (o_a, do_a) = if x >= 0.0 { (x, inside) } else { (0.0, 0.0) };
         let (o_b, do_b) = if x < 0.0 { (-x, -inside) } else { (0.0, 0.0) };
@@ -334,8 +338,9 @@ impl Element for LsSection {
             for (k, d) in dq[port].iter().enumerate().take(n) {
                 jac.set(row, jac.effort_col(k, 0), *d);
             }
-            self.x_v
-                .partials(io, 0, |i, d| jac.set(row, jac.input_col(i, 0), dx[port] * d));
+            self.x_v.partials(io, 0, |i, d| {
+                jac.set(row, jac.input_col(i, 0), dx[port] * d)
+            });
         }
         true
     }
@@ -530,14 +535,19 @@ mod tests {
 
     #[test]
     fn rejects_bad_parameters() {
-        let s = |q: f64, dp: f64, sm: f64| {
-            LsSection::new(Compensator::Pre, q, 10e5, 0.0, dp, sm, 1e5)
-        };
+        let s =
+            |q: f64, dp: f64, sm: f64| LsSection::new(Compensator::Pre, q, 10e5, 0.0, dp, sm, 1e5);
         assert!(s(0.0, 1e6, 0.05).is_err());
         assert!(s(1e-3, 0.0, 0.05).is_err());
         assert!(s(1e-3, 1e6, 0.7).is_err());
-        assert!(s(1e-3, 1e6, 0.05).unwrap().with_ls_edges(0.0, 0.05).is_err());
-        assert!(s(1e-3, 1e6, 0.05).unwrap().with_ls_edges(1e-7, 0.0).is_err());
+        assert!(s(1e-3, 1e6, 0.05)
+            .unwrap()
+            .with_ls_edges(0.0, 0.05)
+            .is_err());
+        assert!(s(1e-3, 1e6, 0.05)
+            .unwrap()
+            .with_ls_edges(1e-7, 0.0)
+            .is_err());
         assert!(s(1e-3, 1e6, 0.05).unwrap().with_leakage(-1.0).is_err());
     }
 }

@@ -23,8 +23,7 @@
 
 use bondgraph::kind::{KindDecl, ParamDecl};
 use bondgraph::{
-    CausalRule, Element, Io, LocalJacobian, ParamError, PortCausality, PortSpec, Ports, Slot,
-    Stage,
+    CausalRule, Element, Io, LocalJacobian, ParamError, PortCausality, PortSpec, Ports, Slot, Stage,
 };
 
 use crate::orifice::{self, reg_root, reg_root_derivative};
@@ -193,7 +192,10 @@ mod tests {
         for k in 1..=120 {
             let pa = 80e5 - 6e4 + 1e3 * f64::from(k);
             let p = dead_end(&v, pa, 80e5);
-            assert!(p >= pa.min(80e5) - 1e-6 && p <= pa.max(80e5) + 1e-6, "{pa}: {p}");
+            assert!(
+                p >= pa.min(80e5) - 1e-6 && p <= pa.max(80e5) + 1e-6,
+                "{pa}: {p}"
+            );
             assert!((p - last).abs() <= 2e3, "{pa}: {p} after {last}");
             last = p;
         }
