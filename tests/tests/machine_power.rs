@@ -128,7 +128,7 @@ b4 = "sl -> m.LS"
             "power in {p_in:e} W, dissipation {dissipation:e} W, through {scale:e} W"
         );
         let rd = |n: &str| eqs.read(eqs.probe(n).unwrap(), 0.0, &x0);
-        prop_assert_eq!(rd("b4.f"), 0.0);
+        prop_assert!(rd("b4.f") == 0.0, "LS port flow {}", rd("b4.f"));
         let (qa, qb) = (rd("b1.f"), rd("b2.f"));
         prop_assert_eq!(qa.to_bits(), qb.to_bits());
         let q = d * eps * w + cl * delta;

@@ -407,6 +407,7 @@ fn build(p: &dyn Params) -> Result<Box<dyn Element>, BuildError> {
 }
 
 #[cfg(test)]
+#[allow(clippy::float_cmp)] // exact zeros and ones of the clamped ramps are meant exactly
 mod tests {
     use super::*;
     use crate::FrictionLaw;

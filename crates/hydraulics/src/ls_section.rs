@@ -327,8 +327,8 @@ impl Element for LsSection {
         let mut dx = [0.0; 6];
         for e in self.edges(self.x_v.value(io, 0), &p) {
             for (port, s) in [(e.from, 1.0), (e.to, -1.0)] {
-                for k in 0..6 {
-                    dq[port][k] += s * e.dq[k];
+                for (d, de) in dq[port].iter_mut().zip(e.dq) {
+                    *d += s * de;
                 }
                 dx[port] += s * e.dx;
             }

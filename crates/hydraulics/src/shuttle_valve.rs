@@ -153,6 +153,7 @@ pub const KIND: KindDecl = KindDecl::element(
 .example("alpha = 5e-7");
 
 #[cfg(test)]
+#[allow(clippy::float_cmp)] // exact zeros and ones of the clamped ramps are meant exactly
 mod tests {
     use super::*;
     use bondgraph::check_partials;
