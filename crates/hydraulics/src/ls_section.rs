@@ -35,8 +35,9 @@
 //! is centred, through small edges of coefficient α_LS: `W → LS` with opening
 //! s = clamp(|x|/x_LS, 0, 1), and `LS → T` with 1 − s. Every edge also leaks `g_leak·Δp`
 //! (P→A, P→B, A→T, B→T). The flows into the section sum to zero (volume), and each edge's
-//! flow has the sign of its drop (Σ P·Q ≥ 0, dissipated). Spool dynamics are outside: feed
-//! `x_v` from the core's `lag` (the spool's time constant).
+//! flow has the sign of its drop (Σ P·Q ≥ 0, dissipated). Spool dynamics: with `tau` (a
+//! datasheet's spool time constant) the stroke is a state `x`, τ·dx/dt = clamp(x_v) − x;
+//! without it the stroke is x_v itself (feed it from the core's `lag` for any other law).
 //!
 //! A post-compensated section has a sixth port, `X`: the LS gallery's pressure (the LS line
 //! after the shuttles, the highest load) that loads its compensator; it passes no flow. Its
@@ -47,7 +48,7 @@
 use bondgraph::kind::{BuildError, KindDecl, ParamDecl, Params, Range};
 use bondgraph::{
     CausalRule, Element, Io, LocalJacobian, Param, ParamError, PortCausality, PortSpec, Ports,
-    SignalSpec, Slot, Stage,
+    SignalSpec, Slot, Stage, StateSpec,
 };
 
 use crate::orifice::{reg_root, reg_root_derivative};
@@ -86,6 +87,7 @@ pub struct LsSection {
     compensator: Compensator,
     alpha: f64,
     x_v: Param,
+    tau: Option<f64>,
     dp_comp: f64,
     eps: f64,
     alpha_ls: f64,
@@ -126,6 +128,7 @@ impl LsSection {
             compensator,
             alpha: q_nom / reg_root(dp_nom, p_tr),
             x_v,
+            tau: None,
             dp_comp,
             eps: smoothing,
             alpha_ls: 5e-7,
@@ -148,6 +151,24 @@ impl LsSection {
         }
         self.x_ls = x_ls;
         Ok(self)
+    }
+
+    /// A first-order spool of time constant `tau` (s, > 0): the stroke becomes a state `x`
+    /// with τ·dx/dt = clamp(x_v, −1, 1) − x, starting centred. `None`: the spool follows x_v.
+    pub fn with_spool_lag(mut self, tau: Option<f64>) -> Result<Self, ParamError> {
+        if let Some(t) = tau {
+            ParamError::positive("tau", t)?;
+        }
+        self.tau = tau;
+        Ok(self)
+    }
+
+    /// The spool stroke now: the state with a spool lag, else x_v.
+    fn stroke(&self, io: &Io<'_>) -> f64 {
+        match self.tau {
+            Some(_) => io.states()[0],
+            None => self.x_v.value(io, 0),
+        }
     }
 
     /// The leak conductance of each main edge, m³/(s·Pa), ≥ 0.
@@ -301,13 +322,21 @@ impl Element for LsSection {
     fn causal_rule(&self, _: usize) -> CausalRule {
         CausalRule::Resistive(vec![vec![PortCausality::FlowOut; self.n_ports()]])
     }
+    fn states(&self) -> Vec<StateSpec> {
+        match self.tau {
+            Some(_) => vec![StateSpec::new("x", 0.0).nominal(1.0)],
+            None => Vec::new(),
+        }
+    }
     fn signal_inputs(&self) -> Vec<SignalSpec> {
         self.x_v.signal_inputs()
     }
     fn stages(&self, _: &[PortCausality]) -> Vec<Stage> {
         let n = self.n_ports();
         let mut reads: Vec<Slot> = (0..n).map(Slot::Effort).collect();
-        reads.extend((0..self.x_v.n_inputs()).map(Slot::Input));
+        if self.tau.is_none() {
+            reads.extend((0..self.x_v.n_inputs()).map(Slot::Input));
+        }
         vec![Stage {
             writes: (0..n).map(Slot::Flow).collect(),
             reads,
@@ -315,7 +344,7 @@ impl Element for LsSection {
     }
     fn eval(&self, _: usize, io: &mut Io<'_>) {
         let p = self.pressures(io);
-        let q = self.flows(self.x_v.value(io, 0), &p);
+        let q = self.flows(self.stroke(io), &p);
         for (k, qk) in q.into_iter().enumerate().take(self.n_ports()) {
             io.set_f_in(k, 0, qk);
         }
@@ -325,7 +354,7 @@ impl Element for LsSection {
         let n = self.n_ports();
         let mut dq = [[0.0; 6]; 6];
         let mut dx = [0.0; 6];
-        for e in self.edges(self.x_v.value(io, 0), &p) {
+        for e in self.edges(self.stroke(io), &p) {
             for (port, s) in [(e.from, 1.0), (e.to, -1.0)] {
                 for (d, de) in dq[port].iter_mut().zip(e.dq) {
                     *d += s * de;
@@ -338,10 +367,35 @@ impl Element for LsSection {
             for (k, d) in dq[port].iter().enumerate().take(n) {
                 jac.set(row, jac.effort_col(k, 0), *d);
             }
-            self.x_v.partials(io, 0, |i, d| {
-                jac.set(row, jac.input_col(i, 0), dx[port] * d)
-            });
+            match self.tau {
+                Some(_) => jac.set(row, jac.state_col(0), dx[port]),
+                None => self.x_v.partials(io, 0, |i, d| {
+                    jac.set(row, jac.input_col(i, 0), dx[port] * d);
+                }),
+            }
         }
+        true
+    }
+    fn derivatives(&self, io: &Io<'_>, dx: &mut [f64]) {
+        if let Some(tau) = self.tau {
+            dx[0] = (self.x_v.value(io, 0).clamp(-1.0, 1.0) - io.states()[0]) / tau;
+        }
+    }
+    fn derivative_partials(&self, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
+        let Some(tau) = self.tau else {
+            return true;
+        };
+        let u = self.x_v.value(io, 0);
+        let slope = if (-1.0..=1.0).contains(&u) {
+            1.0 / tau
+        } else {
+            0.0
+        };
+        let row = jac.derivative_row(0);
+        self.x_v.partials(io, 0, |i, d| {
+            jac.set(row, jac.input_col(i, 0), slope * d);
+        });
+        jac.set(row, jac.state_col(0), -1.0 / tau);
         true
     }
 }
@@ -367,6 +421,9 @@ pub const KIND: KindDecl = KindDecl::element(
             .default(0.05),
         ParamDecl::number("g_leak", "m³/(s·Pa)", "leak conductance of each main edge").non_negative().default(1e-13),
         crate::orifice::P_TR,
+        ParamDecl::number("tau", "s", "spool time constant: a first-order spool, state x, τ·ẋ = clamp(x_v) − x")
+            .positive()
+            .optional("the spool follows x_v (feed it from a `lag`)"),
     ],
     build,
 )
@@ -399,7 +456,8 @@ fn build(p: &dyn Params) -> Result<Box<dyn Element>, BuildError> {
         p.number("p_tr")?,
     )?
     .with_ls_edges(p.number("alpha_ls")?, p.number("ls_stroke")?)?
-    .with_leakage(p.number("g_leak")?)?;
+    .with_leakage(p.number("g_leak")?)?
+    .with_spool_lag(p.optional("tau")?)?;
     Ok(Box::new(s))
 }
 
@@ -531,6 +589,25 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn spool_lag_is_a_first_order_state_with_exact_partials() {
+        let s = section(Compensator::Post)
+            .with_spool_lag(Some(0.05))
+            .unwrap();
+        assert_eq!(s.states(), vec![StateSpec::new("x", 0.0).nominal(1.0)]);
+        let ports = [(1, 1.0, PortCausality::FlowOut); 6];
+        // per port (P, Q), then the command x_v, then the state x
+        for (u, x) in [(0.6, 0.3), (1.4, -0.2), (-0.5, -0.45)] {
+            let mut point = Vec::new();
+            for pk in [170e5, 1e5, 100e5, 20e5, 99.6e5, 99.5e5] {
+                point.extend([pk, 1e-5]);
+            }
+            point.extend([u, x]);
+            assert_eq!(check_partials(&s, &ports, &point), Ok(2), "{u} {x}");
+        }
+        assert!(section(Compensator::Pre).with_spool_lag(Some(0.0)).is_err());
     }
 
     #[test]
