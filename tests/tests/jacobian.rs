@@ -192,3 +192,35 @@ fn crane_jacobian_matches_central_differences_after_a_short_run() {
         w.0
     );
 }
+
+/// The load-sensing circuit with its spools open: one section metering under a rising load
+/// (2.5 s), both in saturation (6.5 s), the cut-off holding a stalled load (9.5 s) — the
+/// pump's controller, the compensators (pre and post), the shuttles and the LS edges active.
+/// The lines' cavitation is switched off: a motor line held at the vapour pressure sits on
+/// the fluid law's steep knee, where central differences lose digits (`hydraulics.chamber`'s
+/// own tests check that law); the LS kinds are what is checked here.
+#[test]
+fn ls_circuit_jacobian_matches_central_differences_mid_run() {
+    let mut sets: Vec<String> = Vec::new();
+    for c in ["pre", "post"] {
+        for k in 1..=2 {
+            for v in ["hose_a", "hose_b", "vol_ls"] {
+                sets.push(format!("elements.{v}{k}_{c}.cavitation=false"));
+            }
+        }
+    }
+    for t_end in ["2.5", "6.5", "9.5"] {
+        let mut set: Vec<&str> = sets.iter().map(String::as_str).collect();
+        let end = format!("simulation.t_end={t_end}");
+        set.push(&end);
+        let mut model = bg_tests::load("ls_circuit", &set).unwrap();
+        let out = model.run().unwrap();
+        assert!(out.error.is_none(), "{:?}", out.error);
+        let t = out.t_final;
+        let w = compare("ls_circuit", &model.equations, t, &out.x_final);
+        eprintln!(
+            "ls_circuit at {t} s: worst entry J[{}][{}] at {:.1e} of the allowance",
+            w.1, w.2, w.0
+        );
+    }
+}

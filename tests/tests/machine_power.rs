@@ -1,6 +1,6 @@
 //! Power and volume bookkeeping of the dissipative hydraulics kinds at random states, loaded
 //! from model text as a user would write them: the pump and the motor (shaft and set-speed
-//! forms) and the friction element. For each, the power into the element equals its
+//! forms), the load-sensing pump and the friction element. For each, the power into the element equals its
 //! dissipation `C_l·Δ² + T_f(ω)·ω` (≥ 0; zero without losses), to 1e-12 of the power
 //! through it, and the machine passes the oil through (flow in at `a` = flow out at `b`).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -88,6 +88,56 @@ proptest! {
         prop_assert_eq!(qa.to_bits(), qb.to_bits());
         let q = d * eps * omega + cl * delta;
         prop_assert!((qa - q).abs() <= 1e-12 * (d * omega.abs() + cl * delta.abs()));
+    }
+
+    /// The LS pump: the displacement machine at its stroke ε (the state), the LS port takes
+    /// no flow and no power, and the stroke moves toward a target within [0, 1].
+    #[test]
+    fn ls_pump_dissipates_exactly_its_losses(
+        eps in 0.0f64..1.0, pa in -1e5f64..3e7, pb in -1e5f64..3e7, pls in 0.0f64..3e7,
+        w in -300.0f64..300.0, cl in 0.0f64..5e-12, tc in 0.0f64..5.0, bv in 0.0f64..0.01,
+    ) {
+        let d = 8e-6;
+        let text = format!(
+            r#"
+[elements]
+sa    = {{ kind = "Se", e = {pa:e} }}
+sb    = {{ kind = "Se", e = {pb:e} }}
+sl    = {{ kind = "Se", e = {pls:e} }}
+drive = {{ kind = "Sf", f = {w:e} }}
+m     = {{ kind = "hydraulics.ls_pump", displacement = {d:e}, p_max = 2.5e7, torque_max = 150.0, eps0 = {eps:e}, c_l = {cl:e}, t_c = {tc:e}, b = {bv:e} }}
+
+[bonds]
+b1 = "sa -> m.a"
+b2 = "m.b -> sb"
+b3 = "drive -> m.shaft"
+b4 = "sl -> m.LS"
+"#
+        );
+        let model = load(&text);
+        let eqs = &model.equations;
+        let x0 = eqs.initial_state();
+        eqs.evaluate(0.0, &x0);
+        let id = eqs.graph().find("m").unwrap();
+        let p_in = eqs.power_into(id);
+        let scale = eqs.power_scale(id);
+        let delta = pa - pb;
+        let dissipation = cl * delta * delta + t_f(tc, 0.1, bv, w) * w;
+        prop_assert!(
+            (p_in - dissipation).abs() <= 1e-12 * scale.max(f64::MIN_POSITIVE),
+            "power in {p_in:e} W, dissipation {dissipation:e} W, through {scale:e} W"
+        );
+        let rd = |n: &str| eqs.read(eqs.probe(n).unwrap(), 0.0, &x0);
+        prop_assert!(rd("b4.f") == 0.0, "LS port flow {}", rd("b4.f"));
+        let (qa, qb) = (rd("b1.f"), rd("b2.f"));
+        prop_assert_eq!(qa.to_bits(), qb.to_bits());
+        let q = d * eps * w + cl * delta;
+        prop_assert!((qa - q).abs() <= 1e-12 * (d * w.abs() + cl * delta.abs()));
+        // τ·dε/dt = ε* − ε with τ = 40 ms (the default, both ways): ε* ∈ [0, 1]
+        let mut dx = vec![0.0; x0.len()];
+        eqs.rhs(0.0, &x0, &mut dx);
+        let target = eps + 0.04 * dx[0];
+        prop_assert!((-1e-12..=1.0 + 1e-12).contains(&target), "ε* = {target}");
     }
 
     /// A pump at a set speed: a flow source; its published drive torque closes the balance.

@@ -5,9 +5,9 @@ use bondgraph::KindDecl;
 
 use crate::{
     accumulator, chamber, check_valve, counterbalance_valve, cylinder, directional_valve, end_stop,
-    flow_control_valve, friction, laminar, leakage, line, machine, orifice, pilot_check_valve,
-    piston, pressure_reducing_valve, relief_valve, sequence_valve, tank, valve, valve_2_2,
-    valve_3_2,
+    flow_control_valve, friction, laminar, leakage, line, ls_line, ls_pump, ls_section, machine,
+    orifice, pilot_check_valve, piston, pressure_reducing_valve, relief_valve, sequence_valve,
+    shuttle_valve, tank, valve, valve_2_2, valve_3_2,
 };
 
 /// Every kind of this crate.
@@ -37,4 +37,8 @@ pub const KINDS: &[KindDecl] = &[
     machine::PUMP,
     machine::MOTOR,
     friction::KIND,
+    ls_pump::KIND,
+    shuttle_valve::KIND,
+    ls_line::KIND,
+    ls_section::KIND,
 ];

@@ -60,6 +60,14 @@
 //!   (`hydraulics.valve_2_2`), [`Valve32`] (`hydraulics.valve_3_2`).
 //! - [`FlowControlValve`] (`hydraulics.flow_control_valve`): pressure-compensated.
 //!
+//! ## Load sensing (`docs/hydraulics.md`, "Load sensing")
+//! - [`LsPump`] (`hydraulics.ls_pump`): variable pump with its swash plate a state, LS
+//!   margin, pressure cut-off, optional torque limiter ([`LsController`]).
+//! - [`ShuttleValve`] (`hydraulics.shuttle_valve`): the higher of two pressures passes.
+//! - `hydraulics.ls_line` ([`ls_line`]): the LS signal volume with its bleed to tank.
+//! - [`LsSection`] (`hydraulics.ls_section`): a proportional 4/3 section with an LS port and
+//!   a pre- or post-compensator ([`Compensator`]).
+//!
 //! ## The cylinder as one component
 //! [`Cylinder`] (`hydraulics.cylinder`) assembles chambers, piston, leakage, valve and end
 //! stop; [`Cylinder::composite`] for model files, [`Cylinder::add_to`] for a [`BondGraph`].
@@ -85,6 +93,9 @@ pub mod kinds;
 pub mod laminar;
 pub mod leakage;
 pub mod line;
+pub mod ls_line;
+pub mod ls_pump;
+pub mod ls_section;
 pub mod machine;
 pub mod orifice;
 pub mod pilot_check_valve;
@@ -94,6 +105,7 @@ pub mod pressure_valve;
 pub mod ramp;
 pub mod relief_valve;
 pub mod sequence_valve;
+pub mod shuttle_valve;
 pub mod tank;
 pub mod valve;
 pub mod valve_2_2;
@@ -115,6 +127,8 @@ pub use kinds::KINDS;
 pub use laminar::{pipe_resistance, Laminar};
 pub use leakage::Leakage;
 pub use line::{Line, LineSpec, Wall};
+pub use ls_pump::{LsController, LsPump};
+pub use ls_section::{Compensator, LsSection};
 pub use machine::{Machine, Role};
 pub use orifice::{alpha, reg_root, reg_root_derivative, Orifice};
 pub use pilot_check_valve::PilotCheckValve;
@@ -124,6 +138,7 @@ pub use pressure_valve::{Opening, PressureValve};
 pub use ramp::ramp;
 pub use relief_valve::ReliefValve;
 pub use sequence_valve::SequenceValve;
+pub use shuttle_valve::{smooth_max, ShuttleValve};
 pub use tank::Tank;
 pub use valve::Valve;
 pub use valve_2_2::Valve22;

@@ -145,6 +145,18 @@ impl Machine {
         self
     }
 
+    /// The laminar leakage coefficient C_l, m³/(s·Pa).
+    #[must_use]
+    pub fn leakage(&self) -> f64 {
+        self.c_l
+    }
+
+    /// The friction torque law T_f(ω).
+    #[must_use]
+    pub fn friction(&self) -> &FrictionLaw {
+        &self.friction
+    }
+
     /// Whether the shaft is a port (false for a pump driven at a set speed).
     #[must_use]
     pub fn has_shaft(&self) -> bool {
@@ -315,7 +327,7 @@ impl Element for Machine {
     }
 }
 
-const DISPLACEMENT: ParamDecl = ParamDecl::number(
+pub(crate) const DISPLACEMENT: ParamDecl = ParamDecl::number(
     "displacement",
     "m³/rad",
     "displacement D_max at full stroke (\"40 cc/rev\" is read as 40e-6/(2π))",
@@ -328,32 +340,40 @@ const FRACTION: ParamDecl = ParamDecl::modulated(
 )
 .range(Range::closed(-1.0, 1.0))
 .default(1.0);
-const C_L: ParamDecl = ParamDecl::number(
+pub(crate) const C_L: ParamDecl = ParamDecl::number(
     "c_l",
     "m³/(s·Pa)",
     "laminar leakage coefficient, Q_leak = C_l·Δp",
 )
 .non_negative()
 .default(0.0);
-const T_C: ParamDecl = ParamDecl::number("t_c", "N·m", "Coulomb friction torque")
+pub(crate) const T_C: ParamDecl = ParamDecl::number("t_c", "N·m", "Coulomb friction torque")
     .non_negative()
     .default(0.0);
-const T_S: ParamDecl = ParamDecl::number("t_s", "N·m", "breakaway friction torque")
+pub(crate) const T_S: ParamDecl = ParamDecl::number("t_s", "N·m", "breakaway friction torque")
     .non_negative()
     .optional("t_c: no Stribeck peak");
-const OMEGA_S: ParamDecl = ParamDecl::number("omega_s", "rad/s", "Stribeck speed")
+pub(crate) const OMEGA_S: ParamDecl = ParamDecl::number("omega_s", "rad/s", "Stribeck speed")
     .positive()
     .optional("needed with t_s");
-const OMEGA_TANH: ParamDecl = ParamDecl::number(
+pub(crate) const OMEGA_TANH: ParamDecl = ParamDecl::number(
     "omega_tanh",
     "rad/s",
     "regularisation speed of the Coulomb torque's sign(ω)",
 )
 .positive()
 .default(0.1);
-const B: ParamDecl = ParamDecl::number("b", "N·m·s/rad", "viscous friction coefficient")
+pub(crate) const B: ParamDecl = ParamDecl::number("b", "N·m·s/rad", "viscous friction coefficient")
     .non_negative()
     .default(0.0);
+
+/// The set shaft speed of a pump (shared with `hydraulics.ls_pump`).
+pub(crate) const SPEED: ParamDecl = ParamDecl::modulated(
+    "speed",
+    "rad/s",
+    "shaft speed ω (\"1500 rpm\", or a signal): the pump is a flow source with no shaft port",
+)
+.optional("a shaft port, driven by the model");
 
 /// The machine of `role` from a model's parameters (`speed` only for the pump).
 fn build(p: &dyn Params, role: Role) -> Result<Machine, BuildError> {
@@ -386,12 +406,7 @@ pub const PUMP: KindDecl = KindDecl::element(
         OMEGA_S,
         OMEGA_TANH,
         B,
-        ParamDecl::modulated(
-            "speed",
-            "rad/s",
-            "shaft speed ω (\"1500 rpm\", or a signal): the pump is a flow source with no shaft port",
-        )
-        .optional("a shaft port, driven by the model"),
+        SPEED,
     ],
     |p| Ok(Box::new(build(p, Role::Pump)?)),
 )
