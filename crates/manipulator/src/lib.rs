@@ -58,6 +58,9 @@ pub mod projection;
 pub mod quadrature;
 pub mod shape_integrals;
 
+// Beyond the paper's beam
+pub mod geometric_stiffening;
+
 // Dynamics (section 3.2)
 mod cholesky;
 pub mod gravity;

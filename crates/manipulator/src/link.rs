@@ -36,6 +36,7 @@ pub struct Link {
     bending_stiffness: f64,
     modes: Vec<Arc<dyn ModeShape>>,
     masses: Vec<PointMass>,
+    geometric_stiffening: bool,
 }
 
 impl Link {
@@ -49,6 +50,7 @@ impl Link {
             bending_stiffness: 0.0,
             modes: Vec::new(),
             masses: Vec::new(),
+            geometric_stiffening: false,
         })
     }
 
@@ -121,6 +123,16 @@ impl Link {
         Ok(self)
     }
 
+    /// Keep (`true`) the second-order axial shortening of the bent link,
+    /// `u(x) = −½∫₀ˣ (∂w/∂ξ)² dξ`, in the position of its material points, its pins and the
+    /// end of its chord ([`geometric_stiffening`](crate::geometric_stiffening)). Off by default
+    /// (the paper's beam); no effect on a rigid link.
+    #[must_use]
+    pub fn with_geometric_stiffening(mut self, on: bool) -> Self {
+        self.geometric_stiffening = on;
+        self
+    }
+
     /// Add a point mass on the deformed axis.
     pub fn with_point_mass(mut self, m: PointMass) -> Result<Self, ParamError> {
         if !(m.x.is_finite() && (0.0..=self.length).contains(&m.x)) {
@@ -165,6 +177,11 @@ impl Link {
     #[must_use]
     pub fn point_masses(&self) -> &[PointMass] {
         &self.masses
+    }
+    /// Whether the axial shortening of the bent link is kept (and it has modes).
+    #[must_use]
+    pub fn geometric_stiffening(&self) -> bool {
+        self.geometric_stiffening && !self.modes.is_empty()
     }
     /// Whether the link has no modes.
     #[must_use]

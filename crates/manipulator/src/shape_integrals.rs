@@ -35,6 +35,7 @@
 
 use nalgebra::DMatrix;
 
+use crate::geometric_stiffening::ShorteningIntegrals;
 use crate::link::Link;
 use crate::mode_shape::ModeShape;
 use crate::quadrature::GaussLegendre;
@@ -49,6 +50,8 @@ pub struct ShapeIntegrals {
     rotation: DMatrix<f64>,
     /// K of the link's modes, m × m.
     bending: DMatrix<f64>,
+    /// With geometric stiffening: the integrals of the shortening.
+    shortening: Option<ShorteningIntegrals>,
 }
 
 /// The ρA-weighted moments of a link's deflection at (q, u) that the dynamics need:
@@ -91,6 +94,7 @@ impl ShapeIntegrals {
             translation: DMatrix::zeros(m + 2, m + 2),
             rotation: DMatrix::zeros(m + 1, m + 1),
             bending: DMatrix::zeros(m, m),
+            shortening: None,
         };
         let sines: Option<Vec<f64>> = link.modes().iter().map(|p| p.sine_wavenumber()).collect();
         match sines {
@@ -105,6 +109,9 @@ impl ShapeIntegrals {
             features(link.modes(), pm.x, &mut phi, &mut chi);
             add_outer(&mut s.translation, pm.mass, &phi);
             add_outer(&mut s.rotation, pm.inertia, &chi);
+        }
+        if link.geometric_stiffening() {
+            s.shortening = Some(ShorteningIntegrals::of(link, points)?);
         }
         Ok(s)
     }
@@ -172,6 +179,12 @@ impl ShapeIntegrals {
     #[must_use]
     pub fn bending(&self) -> &DMatrix<f64> {
         &self.bending
+    }
+    /// The integrals of the axial shortening, if the link keeps it
+    /// ([`geometric_stiffening`](crate::geometric_stiffening)).
+    #[must_use]
+    pub fn shortening(&self) -> Option<&ShorteningIntegrals> {
+        self.shortening.as_ref()
     }
     /// Number of modes m.
     #[must_use]
