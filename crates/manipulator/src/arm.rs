@@ -71,6 +71,15 @@ impl PlanarArm {
             return Err(ParamError::shape("links", "an arm needs at least one link"));
         }
         ParamError::finite("gravity", gravity)?;
+        if let Some(k) = links[..links.len() - 1].iter().position(Link::has_free_end) {
+            return Err(ParamError::shape(
+                "links",
+                format!(
+                    "link {} has cantilever modes, which move the end of its chord: only the last link may (the next joint sits on the chord's end)",
+                    k + 1
+                ),
+            ));
+        }
         let quadrature = GaussLegendre::new(points)?;
         let mut modal_offset = Vec::with_capacity(links.len());
         let mut n = links.len();

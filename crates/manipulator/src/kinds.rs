@@ -23,6 +23,7 @@
 //! lumped_stiffness = "k_c"            # N/m, with "springs"
 //! lumped_damping = "c_c"              # N·s/m, with "springs"
 //! paper_reactions = false             # also publish rho{k}_paper (springs only)
+//! geometric_stiffening = false        # keep the axial shortening of the bent links
 //! ```
 //!
 //! Links are numbered from 1 as in the paper. A link table has `type` = `"beam"` (length, E,
@@ -131,6 +132,7 @@ pub const PLANAR_ARM: KindDecl = KindDecl::composite(
         ParamDecl::number("lumped_stiffness", "N/m", "spring stiffness of lumped masses (with \"springs\")").positive().optional("needed with springs"),
         ParamDecl::number("lumped_damping", "N·s/m", "spring damping of lumped masses (with \"springs\")").non_negative().default(0.0),
         ParamDecl::flag("paper_reactions", false, "also publish rho{k}_paper (springs only)"),
+        ParamDecl::flag("geometric_stiffening", false, "keep the axial shortening of bent links (axial-force stiffening; docs/manipulator.md)"),
     ],
     build_planar_arm,
 )
@@ -244,6 +246,11 @@ fn scene(p: &dyn Params) -> Result<ArmScene, BuildError> {
         .enumerate()
         .map(|(k, t)| link(k, t.as_ref()))
         .collect::<Result<Vec<_>, _>>()?;
+    let stiffening = p.flag("geometric_stiffening")?;
+    let links: Vec<Link> = links
+        .into_iter()
+        .map(|l| l.with_geometric_stiffening(stiffening))
+        .collect();
     if links.is_empty() {
         return Err(BuildError::missing(
             "links",

@@ -96,7 +96,7 @@ pub use kinds::KINDS;
 pub use kinematics::ArmKinematics;
 pub use link::{Link, PointMass};
 pub use lumped_mass::LumpedMass;
-pub use mode_shape::{ModeShape, SineMode};
+pub use mode_shape::{CantileverMode, ModeShape, SineMode};
 pub use pin::{Pin, PinPoint};
 pub use projection::Projection;
 pub use quadrature::GaussLegendre;

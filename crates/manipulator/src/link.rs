@@ -13,7 +13,7 @@
 
 use std::sync::Arc;
 
-use crate::mode_shape::{ModeShape, SineMode};
+use crate::mode_shape::{CantileverMode, ModeShape, SineMode};
 use bondgraph::ParamError;
 
 /// A point mass on the deformed axis of a link, at distance `x` along the chord.
@@ -37,6 +37,7 @@ pub struct Link {
     modes: Vec<Arc<dyn ModeShape>>,
     masses: Vec<PointMass>,
     geometric_stiffening: bool,
+    free_end: bool,
 }
 
 impl Link {
@@ -51,6 +52,7 @@ impl Link {
             modes: Vec::new(),
             masses: Vec::new(),
             geometric_stiffening: false,
+            free_end: false,
         })
     }
 
@@ -98,6 +100,26 @@ impl Link {
         (1..=n).try_fold(self, |link, k| {
             link.with_mode(Arc::new(SineMode::new(k, l)))
         })
+    }
+
+    /// Add the first `n` clamped–free modes ([`CantileverMode`]): the link must be the last
+    /// of its arm (its end carries no joint; [`PlanarArm`](crate::PlanarArm) checks it), and
+    /// its joint angle is then the angle of its root cross-section.
+    pub fn with_cantilever_modes(mut self, n: u32) -> Result<Self, ParamError> {
+        ParamError::positive("EI", self.bending_stiffness)?;
+        let l = self.length;
+        for k in 1..=n {
+            self.modes.push(Arc::new(CantileverMode::new(k, l)));
+        }
+        self.free_end = n > 0;
+        Ok(self)
+    }
+
+    /// Whether the link's modes move the end of its chord (cantilever modes): it must be the
+    /// last link.
+    #[must_use]
+    pub fn has_free_end(&self) -> bool {
+        self.free_end
     }
 
     /// Add an assumed mode. It must vanish at both ends of the chord (chord-to-chord joint
