@@ -438,11 +438,21 @@ impl<'a> Pose<'a> {
         }
         let (c, sn) = self.frames.cs[i];
         let o = self.arm.modal_offset[i];
-        for (k, psi) in s.psi.iter().enumerate() {
-            column(o + k, Vector2::new(-sn * psi, c * psi));
+        if s.shortening.is_empty() {
+            for (k, psi) in s.psi.iter().enumerate() {
+                column(o + k, Vector2::new(-sn * psi, c * psi));
+            }
+        } else {
+            // one column per coordinate (callers may assign): ψ_k n_i − (S(x)q)_k e_i
+            let q = self.modal(i);
+            let m = q.len();
+            for (k, psi) in s.psi.iter().enumerate() {
+                let sq: f64 = (0..m).map(|l| s.shortening[k * m + l] * q[l]).sum();
+                column(o + k, Vector2::new(-sn * psi - sq * c, c * psi - sq * sn));
+            }
         }
         if self.arm.stiffening {
-            self.shortening_columns(s, column);
+            self.shortening_columns_of(s, false, column);
         }
     }
     /// `out += (∂r/∂q)ᵀ f`: the generalized force of a force `f` (frame 0) at a station

@@ -187,6 +187,7 @@ impl Pose<'_> {
     fn shortening_terms(
         &self,
         s: &Station,
+        own: bool,
         mut f: impl FnMut(usize, &dyn Fn(usize, usize) -> f64),
     ) {
         let arm = self.arm();
@@ -196,7 +197,7 @@ impl Pose<'_> {
                 f(j, &|a, b| c[(a, b)]);
             }
         }
-        if !s.shortening.is_empty() {
+        if own && !s.shortening.is_empty() {
             let m = s.psi.len();
             f(s.link, &|a, b| s.shortening[a * m + b]);
         }
@@ -204,9 +205,19 @@ impl Pose<'_> {
 
     /// The columns `∂Δ/∂q^b_k = −(S q)_k e_j` of the shortening of a station, for the modes
     /// of its link and of the links inboard of it: `column(k, ·)`.
-    pub fn shortening_columns(&self, s: &Station, mut column: impl FnMut(usize, Vector2<f64>)) {
+    pub fn shortening_columns(&self, s: &Station, column: impl FnMut(usize, Vector2<f64>)) {
+        self.shortening_columns_of(s, true, column);
+    }
+
+    /// [`shortening_columns`](Self::shortening_columns), of the inboard links only if `!own`.
+    pub(crate) fn shortening_columns_of(
+        &self,
+        s: &Station,
+        own: bool,
+        mut column: impl FnMut(usize, Vector2<f64>),
+    ) {
         let arm = self.arm();
-        self.shortening_terms(s, |j, sm| {
+        self.shortening_terms(s, own, |j, sm| {
             let q = self.modal(j);
             let (c, sn) = self.cos_sin(j);
             let o = arm.modal_offset(j);
@@ -227,7 +238,7 @@ impl Pose<'_> {
         mut entry: impl FnMut(usize, usize, Vector2<f64>),
     ) {
         let arm = self.arm();
-        self.shortening_terms(s, |j, sm| {
+        self.shortening_terms(s, true, |j, sm| {
             let q = self.modal(j);
             let (c, sn) = self.cos_sin(j);
             let (e, n) = (Vector2::new(c, sn), Vector2::new(-sn, c));

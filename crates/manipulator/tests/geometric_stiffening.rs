@@ -10,7 +10,7 @@ mod common;
 
 use std::f64::consts::PI;
 
-use bg_manipulator::{Link, PlanarArm};
+use bg_manipulator::{Link, Pin, PlanarArm};
 use common::{crane_links, cylinders, Rng, G};
 use nalgebra::{DMatrix, DVector, Vector2};
 
@@ -218,6 +218,16 @@ fn points_and_actuators_move_with_the_shortening_and_their_derivatives_match() {
             };
             let fd = jacobian_fd(&q, |q| gen(&stiff, q)) - jacobian_fd(&q, |q| gen(&plain, q));
             assert_change("∂²(f·r)/∂q²", &(hess(&stiff) - hess(&plain)), &fd);
+        }
+        // J_c (the callers of point_jacobian may assign a column: one per coordinate)
+        for pin in [Pin::on_link(0, 4.0), Pin::on_link(1, 3.0)] {
+            let jc = stiff.pin_jacobian(&stiff.pose(&q), &pin);
+            let fd = jacobian_fd(&q, |q| {
+                let r = stiff.pose(q).pin_position(&pin);
+                DVector::from_column_slice(&[r.x, r.y])
+            });
+            let err = (&jc - &fd).abs().max() / fd.abs().max();
+            assert!(err < 1e-7, "J_c: {err:e}");
         }
         for act in &cylinders() {
             let grad = |a: &PlanarArm, q: &[f64]| {
