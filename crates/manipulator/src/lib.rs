@@ -35,6 +35,11 @@
 //! ## Reaction forces (section 5)
 //! [`ArmKinematics::reactions`] (eqs. 84–98) with [`PointLoad`]s.
 //!
+//! ## Beyond the paper's beam
+//! [`geometric_stiffening`]: a link option keeping the second-order axial shortening of the
+//! bent link in the positions of its points, pins and chord end (axial-force stiffening),
+//! with its precomputed [`ShorteningIntegrals`]; [`CantileverMode`]s for the last link.
+//!
 //! ## Bond-graph elements (section 4)
 //! [`elements`]: the I-field ([`ArmInertia`]), C-field ([`ArmCompliance`]), R-field
 //! ([`ArmDamping`]), the MTFs to the cylinders ([`ActuatorTransformer`]) and to the lumped
@@ -103,4 +108,5 @@ pub use quadrature::GaussLegendre;
 pub use reactions::PointLoad;
 pub use scene::{ArmScene, LumpedMassModel};
 pub use screw::{CoordinateTransform, ReferenceTransform, ScrewTransform};
+pub use geometric_stiffening::ShorteningIntegrals;
 pub use shape_integrals::ShapeIntegrals;
