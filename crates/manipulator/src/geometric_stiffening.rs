@@ -116,7 +116,16 @@ impl ShorteningIntegrals {
             for (t, mode) in slope.iter_mut().zip(link.modes()) {
                 *t = mode.slope(xi);
             }
-            let (wa, wd) = (rho_a * (l - xi), rho_a * 0.5 * (l * l - xi * xi));
+            // ∫_ξ^L ρA dx and ∫_ξ^L ρA x dx
+            let (wa, wd) = if link.is_uniform() {
+                (rho_a * (l - xi), rho_a * 0.5 * (l * l - xi * xi))
+            } else {
+                rule.on(l - xi).fold((0.0, 0.0), |(a, d), (y, wy)| {
+                    let x = xi + y;
+                    let m = wy * link.mass_per_length_at(x);
+                    (a + m, d + m * x)
+                })
+            };
             for a in 0..m {
                 for b in 0..m {
                     let p = w * slope[a] * slope[b];

@@ -36,7 +36,7 @@ use bondgraph::kind::{BuildError, KindDecl, ParamDecl, Params, Range};
 use bondgraph::{Composite, ParamError};
 
 use crate::actuator::LinearActuator;
-use crate::link::{Link, PointMass};
+use crate::link::{Link, PointMass, Profile};
 use crate::lumped_mass::LumpedMass;
 use crate::pin::Pin;
 use crate::quadrature::GaussLegendre;
@@ -90,6 +90,24 @@ const LINK: &[ParamDecl] = &[
         .non_negative()
         .optional("pendulum only"),
     ParamDecl::tables("point_masses", POINT_MASS, "point masses on the link").optional("none"),
+    ParamDecl::vector(
+        "EI_samples",
+        "N·m²",
+        "EI(x) sampled at equally spaced x from 0 to L, linear between (beam; replaces E·I)",
+    )
+    .optional("uniform"),
+    ParamDecl::vector(
+        "rhoA_samples",
+        "kg/m",
+        "ρA(x) sampled likewise (beam; replaces rho·A)",
+    )
+    .optional("uniform"),
+    ParamDecl::vector(
+        "rhoI_samples",
+        "kg·m",
+        "ρI(x) sampled likewise (beam; replaces rho·I)",
+    )
+    .optional("uniform"),
 ];
 
 const PIN: &[ParamDecl] = &[
@@ -162,7 +180,20 @@ fn link(k: usize, t: &dyn Params) -> Result<Link, BuildError> {
     };
     let mut l = match kind.as_str() {
         "rigid" => {
-            only(&["E", "rho", "A", "I", "modes", "mass"], "rigid")?;
+            only(
+                &[
+                    "E",
+                    "rho",
+                    "A",
+                    "I",
+                    "modes",
+                    "mass",
+                    "EI_samples",
+                    "rhoA_samples",
+                    "rhoI_samples",
+                ],
+                "rigid",
+            )?;
             let (m, j) = (
                 t.number("mass_per_length")?,
                 t.number("rotary_inertia_per_length")?,
@@ -181,6 +212,9 @@ fn link(k: usize, t: &dyn Params) -> Result<Link, BuildError> {
                     "modes",
                     "mass_per_length",
                     "rotary_inertia_per_length",
+                    "EI_samples",
+                    "rhoA_samples",
+                    "rhoI_samples",
                 ],
                 "pendulum",
             )?;
@@ -199,6 +233,23 @@ fn link(k: usize, t: &dyn Params) -> Result<Link, BuildError> {
                 t.number("I")?,
             )
             .map_err(fail())?;
+            let samples = |key: &str| -> Result<Option<Vec<f64>>, BuildError> {
+                if t.has(key) {
+                    Ok(Some(t.vector(key)?))
+                } else {
+                    Ok(None)
+                }
+            };
+            let profile = Profile {
+                bending_stiffness: samples("EI_samples")?,
+                mass_per_length: samples("rhoA_samples")?,
+                rotary_inertia_per_length: samples("rhoI_samples")?,
+            };
+            let beam = if profile == Profile::default() {
+                beam
+            } else {
+                beam.with_profile(profile).map_err(fail())?
+            };
             beam.with_sine_modes(t.count("modes")? as u32)
                 .map_err(fail())?
         }

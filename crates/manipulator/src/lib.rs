@@ -96,10 +96,11 @@ pub use elements::{
     lumped_masses, ActuatorTransformer, ArmCompliance, ArmDamping, ArmInertia, ArmReactions,
     LumpedGravity, LumpedMassTransformer,
 };
+pub use geometric_stiffening::ShorteningIntegrals;
 pub use joint::RevoluteJoint;
 pub use kinds::KINDS;
 pub use kinematics::ArmKinematics;
-pub use link::{Link, PointMass};
+pub use link::{Link, PointMass, Profile};
 pub use lumped_mass::LumpedMass;
 pub use mode_shape::{CantileverMode, ModeShape, SineMode};
 pub use pin::{Pin, PinPoint};
@@ -108,5 +109,4 @@ pub use quadrature::GaussLegendre;
 pub use reactions::PointLoad;
 pub use scene::{ArmScene, LumpedMassModel};
 pub use screw::{CoordinateTransform, ReferenceTransform, ScrewTransform};
-pub use geometric_stiffening::ShorteningIntegrals;
 pub use shape_integrals::ShapeIntegrals;

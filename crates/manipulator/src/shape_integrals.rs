@@ -96,7 +96,11 @@ impl ShapeIntegrals {
             bending: DMatrix::zeros(m, m),
             shortening: None,
         };
-        let sines: Option<Vec<f64>> = link.modes().iter().map(|p| p.sine_wavenumber()).collect();
+        let sines: Option<Vec<f64>> = if link.is_uniform() {
+            link.modes().iter().map(|p| p.sine_wavenumber()).collect()
+        } else {
+            None
+        };
         match sines {
             Some(kappa) => s.add_sines(link, &kappa),
             None => s.add_quadrature(
@@ -155,13 +159,13 @@ impl ShapeIntegrals {
             for (c, mode) in curv.iter_mut().zip(link.modes()) {
                 *c = mode.curvature(x);
             }
-            add_outer(&mut self.translation, w * link.mass_per_length(), &phi);
+            add_outer(&mut self.translation, w * link.mass_per_length_at(x), &phi);
             add_outer(
                 &mut self.rotation,
-                w * link.rotary_inertia_per_length(),
+                w * link.rotary_inertia_per_length_at(x),
                 &chi,
             );
-            add_outer(&mut self.bending, w * link.bending_stiffness(), &curv);
+            add_outer(&mut self.bending, w * link.bending_stiffness_at(x), &curv);
         }
     }
 
