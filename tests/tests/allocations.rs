@@ -119,6 +119,15 @@ fn rhs_and_jacobian_do_not_allocate() {
         checked.push(name);
     }
     check("every_kind");
+    // the crane with the axial shortening of its booms (geometric stiffening)
+    let stiff = bg_tests::load(
+        "knuckle_boom",
+        &["elements.crane.geometric_stiffening=true"],
+    )
+    .unwrap();
+    let (rhs, jac) = allocations(&stiff.equations);
+    assert_eq!(rhs, (0, 0), "knuckle_boom with stiffening: rhs");
+    assert_eq!(jac, (0, 0), "knuckle_boom with stiffening: Jacobian");
     for must in ["mass_spring_damper", "cylinder_lift", "knuckle_boom"] {
         assert!(checked.iter().any(|c| c == must), "{must} not checked");
     }

@@ -224,3 +224,31 @@ fn ls_circuit_jacobian_matches_central_differences_mid_run() {
         );
     }
 }
+
+#[test]
+fn crane_with_geometric_stiffening_jacobian_matches_central_differences() {
+    // the axial shortening of the bent booms (`elements.crane.geometric_stiffening`), at the
+    // initial state, perturbed states, and after a short run
+    let mut model = bg_tests::load(
+        "knuckle_boom",
+        &[
+            "elements.crane.geometric_stiffening=true",
+            "simulation.t_end=0.05",
+        ],
+    )
+    .unwrap();
+    let worst = check_equations("knuckle_boom (stiffening)", &model.equations).unwrap();
+    assert!(worst <= 1.0, "{worst}");
+    let out = model.run().unwrap();
+    assert!(out.error.is_none(), "{:?}", out.error);
+    let w = compare(
+        "knuckle_boom (stiffening)",
+        &model.equations,
+        out.t_final,
+        &out.x_final,
+    );
+    eprintln!(
+        "knuckle_boom with stiffening after {} s: worst at {:.1e} of the allowance",
+        out.t_final, w.0
+    );
+}

@@ -118,7 +118,7 @@ impl Pose<'_> {
         j: usize,
     ) -> Vector2<f64> {
         let (ra, rb) = (self.pin_point_position(a), self.pin_point_position(b));
-        let o = self.origin(j);
+        let o = self.pivot(j);
         match (turns(a, j), turns(b, j)) {
             (true, true) => z_cross(&(rb - ra)),
             (false, true) => z_cross(&(rb - o)),
@@ -140,6 +140,9 @@ impl Pose<'_> {
                 let o = self.arm().modal_offset(s.link);
                 for (k, psi) in s.psi.iter().enumerate() {
                     column(o + k, sign * psi * Vector2::new(-sn, c));
+                }
+                if self.arm().has_geometric_stiffening() {
+                    self.shortening_columns(s, |k, col| column(k, sign * col));
                 }
             }
         }

@@ -32,6 +32,8 @@ pub struct Station {
     pub x: f64,
     pub(crate) psi: Vec<f64>,
     pub(crate) theta: Vec<f64>,
+    /// With geometric stiffening: `S(x) = ∫₀ˣ ψ'ψ'ᵀ`, row-major m × m; else empty.
+    pub(crate) shortening: Vec<f64>,
 }
 
 /// A planar serial manipulator.
@@ -44,6 +46,10 @@ pub struct PlanarArm {
     modal_offset: Vec<usize>,
     n: usize,
     integrals: Vec<ShapeIntegrals>,
+    /// Mass outboard of each link (kg).
+    outboard: Vec<f64>,
+    /// Whether any link keeps its axial shortening.
+    stiffening: bool,
 }
 
 impl PlanarArm {
@@ -65,6 +71,15 @@ impl PlanarArm {
             return Err(ParamError::shape("links", "an arm needs at least one link"));
         }
         ParamError::finite("gravity", gravity)?;
+        if let Some(k) = links[..links.len() - 1].iter().position(Link::has_free_end) {
+            return Err(ParamError::shape(
+                "links",
+                format!(
+                    "link {} has cantilever modes, which move the end of its chord: only the last link may (the next joint sits on the chord's end)",
+                    k + 1
+                ),
+            ));
+        }
         let quadrature = GaussLegendre::new(points)?;
         let mut modal_offset = Vec::with_capacity(links.len());
         let mut n = links.len();
@@ -75,7 +90,11 @@ impl PlanarArm {
         let integrals = links
             .iter()
             .map(|l| ShapeIntegrals::of(l, points))
-            .collect::<Result<_, _>>()?;
+            .collect::<Result<Vec<_>, _>>()?;
+        let outboard = (0..links.len())
+            .map(|i| links[i + 1..].iter().map(Link::mass).sum())
+            .collect();
+        let stiffening = links.iter().any(Link::geometric_stiffening);
         Ok(Self {
             links,
             joint: RevoluteJoint,
@@ -84,6 +103,8 @@ impl PlanarArm {
             modal_offset,
             n,
             integrals,
+            outboard,
+            stiffening,
         })
     }
 
@@ -127,6 +148,16 @@ impl PlanarArm {
     pub fn shape_integrals(&self, i: usize) -> &ShapeIntegrals {
         &self.integrals[i]
     }
+    /// Mass outboard of link `i`: of the links after it (kg).
+    #[must_use]
+    pub fn outboard_mass(&self, i: usize) -> f64 {
+        self.outboard[i]
+    }
+    /// Whether any link keeps its axial shortening (geometric stiffening).
+    #[must_use]
+    pub fn has_geometric_stiffening(&self) -> bool {
+        self.stiffening
+    }
     /// Total mass of the arm (kg).
     #[must_use]
     pub fn mass(&self) -> f64 {
@@ -162,12 +193,18 @@ impl PlanarArm {
     }
 
     pub(crate) fn station_unchecked(&self, link: usize, x: f64) -> Station {
-        let modes = self.links[link].modes();
+        let l = &self.links[link];
+        let modes = l.modes();
         Station {
             link,
             x,
             psi: modes.iter().map(|m| m.value(x)).collect(),
             theta: modes.iter().map(|m| m.slope(x)).collect(),
+            shortening: if l.geometric_stiffening() {
+                crate::geometric_stiffening::slope_products(modes, x)
+            } else {
+                Vec::new()
+            },
         }
     }
 
@@ -179,6 +216,7 @@ impl PlanarArm {
             phi: Vec::with_capacity(nl),
             cs: Vec::with_capacity(nl),
             origin: Vec::with_capacity(nl + 1),
+            shift: Vec::with_capacity(nl + 1),
         }
     }
 
@@ -223,7 +261,8 @@ impl PlanarArm {
         f.phi.clear();
         f.cs.clear();
         f.origin.clear();
-        let (mut a, mut o) = (0.0, Vector2::zeros());
+        f.shift.clear();
+        let (mut a, mut o, mut shift) = (0.0, Vector2::zeros(), Vector2::zeros());
         for (i, link) in self.links.iter().enumerate() {
             a += q[i];
             let (s, c) = a.sin_cos();
@@ -231,8 +270,26 @@ impl PlanarArm {
             f.cs.push((c, s));
             f.origin.push(o);
             o += link.length() * Vector2::new(c, s);
+            if self.stiffening {
+                f.shift.push(shift);
+                if let Some(sh) = self.integrals[i].shortening() {
+                    // s_i = −½ qᵀS(L)q: the chord end moves along the chord
+                    let qb = &q[self.modal_offset[i]..self.modal_offset[i] + link.modes().len()];
+                    let c_l = sh.chord();
+                    let mut v = 0.0;
+                    for (k, qk) in qb.iter().enumerate() {
+                        for (m, qm) in qb.iter().enumerate() {
+                            v += qk * c_l[(k, m)] * qm;
+                        }
+                    }
+                    shift += -0.5 * v * Vector2::new(c, s);
+                }
+            }
         }
         f.origin.push(o);
+        if self.stiffening {
+            f.shift.push(shift);
+        }
     }
 }
 
@@ -244,6 +301,9 @@ pub struct Frames {
     /// (cos φ_i, sin φ_i)
     cs: Vec<(f64, f64)>,
     origin: Vec<Vector2<f64>>,
+    /// With geometric stiffening: `o'_i − o_i = Σ_{j<i} s_j e_j`, the displacement of joint i
+    /// by the shortening of the chords before it; else empty.
+    shift: Vec<Vector2<f64>>,
 }
 
 /// The arm at one configuration q: chord angles, joint positions, deflections.
@@ -306,6 +366,16 @@ impl<'a> Pose<'a> {
     pub fn origin(&self, i: usize) -> Vector2<f64> {
         self.frames.origin[i]
     }
+    /// Position of joint i in frame 0 with the chords shortened by bending
+    /// ([`geometric_stiffening`](crate::geometric_stiffening)): `o_i + Σ_{j<i} s_j e_j`; the
+    /// paper's [`origin`](Self::origin) without it. Pins turn about these points.
+    #[must_use]
+    pub fn pivot(&self, i: usize) -> Vector2<f64> {
+        match self.frames.shift.get(i) {
+            Some(d) => self.frames.origin[i] + d,
+            None => self.frames.origin[i],
+        }
+    }
     /// The modal coordinates of link i.
     #[must_use]
     pub fn modal(&self, i: usize) -> &[f64] {
@@ -330,15 +400,20 @@ impl<'a> Pose<'a> {
             .map(|(p, q)| p * q)
             .sum()
     }
-    /// Position of a station in its link's frame: `(x, w(x))`.
+    /// Position of a station in its link's frame: `(x, w(x))`, or `(x + u(x), w(x))` with the
+    /// axial shortening u of geometric stiffening.
     #[must_use]
     pub fn local(&self, s: &Station) -> Vector2<f64> {
-        Vector2::new(s.x, self.deflection(s))
+        if s.shortening.is_empty() {
+            Vector2::new(s.x, self.deflection(s))
+        } else {
+            Vector2::new(s.x + self.axial_shortening(s), self.deflection(s))
+        }
     }
     /// Position of a station in frame 0.
     #[must_use]
     pub fn position(&self, s: &Station) -> Vector2<f64> {
-        self.frames.origin[s.link] + self.to_base(s.link, &self.local(s))
+        self.pivot(s.link) + self.to_base(s.link, &self.local(s))
     }
     /// `(cos φ_i, sin φ_i)`.
     #[must_use]
@@ -359,12 +434,25 @@ impl<'a> Pose<'a> {
         let i = s.link;
         let r = self.position(s);
         for j in 0..=i {
-            column(j, z_cross(&(r - self.frames.origin[j])));
+            column(j, z_cross(&(r - self.pivot(j))));
         }
         let (c, sn) = self.frames.cs[i];
         let o = self.arm.modal_offset[i];
-        for (k, psi) in s.psi.iter().enumerate() {
-            column(o + k, Vector2::new(-sn * psi, c * psi));
+        if s.shortening.is_empty() {
+            for (k, psi) in s.psi.iter().enumerate() {
+                column(o + k, Vector2::new(-sn * psi, c * psi));
+            }
+        } else {
+            // one column per coordinate (callers may assign): ψ_k n_i − (S(x)q)_k e_i
+            let q = self.modal(i);
+            let m = q.len();
+            for (k, psi) in s.psi.iter().enumerate() {
+                let sq: f64 = (0..m).map(|l| s.shortening[k * m + l] * q[l]).sum();
+                column(o + k, Vector2::new(-sn * psi - sq * c, c * psi - sq * sn));
+            }
+        }
+        if self.arm.stiffening {
+            self.shortening_columns_of(s, false, column);
         }
     }
     /// `out += (∂r/∂q)ᵀ f`: the generalized force of a force `f` (frame 0) at a station

@@ -62,6 +62,9 @@ impl ArmKinematics<'_> {
                 forces[o + k] -= g * c * si.mode_mass(k);
             }
         }
+        if arm.has_geometric_stiffening() {
+            v += self.add_stiffening_gravity(forces);
+        }
         v
     }
 }

@@ -95,6 +95,9 @@ impl ArmKinematics<'_> {
                 }
             }
         }
+        if arm.has_geometric_stiffening() {
+            self.add_stiffening_kinetic_partials(u, b, h);
+        }
     }
 
     /// `∂²V_g/∂q²` (= −∂G/∂q) into an n×n matrix, without allocating.
@@ -127,6 +130,9 @@ impl ArmKinematics<'_> {
                 }
             }
         }
+        if arm.has_geometric_stiffening() {
+            self.add_stiffening_gravity_hessian(h);
+        }
     }
 }
 
@@ -138,7 +144,7 @@ impl Pose<'_> {
         let r = self.position(s);
         for j in 0..=i {
             for l in 0..=i {
-                entry(j, l, self.origin(j.max(l)) - r);
+                entry(j, l, self.pivot(j.max(l)) - r);
             }
         }
         let (c, sn) = self.cos_sin(i);
@@ -149,6 +155,9 @@ impl Pose<'_> {
                 entry(j, o + k, v);
                 entry(o + k, j, v);
             }
+        }
+        if self.arm().has_geometric_stiffening() {
+            self.shortening_hessian(s, entry);
         }
     }
 
@@ -190,7 +199,7 @@ impl Pose<'_> {
         for j in 0..n_links {
             for m in 0..n_links {
                 let top = j.max(m);
-                let o = self.origin(top);
+                let o = self.pivot(top);
                 let v = match (turns(a, top), turns(b, top)) {
                     (true, true) => -l,
                     (false, true) => -e.dot(&(rb - o)),
@@ -211,6 +220,14 @@ impl Pose<'_> {
                         hess[(j, o + k)] += v;
                         hess[(o + k, j)] += v;
                     }
+                }
+            }
+        }
+        // the shortening of geometric stiffening: e·∂²Δ/∂q∂q in the pairs with a mode
+        if self.arm().has_geometric_stiffening() {
+            for (pin, sign) in [(b, 1.0), (a, -1.0)] {
+                if let PinPoint::Station(s) = pin {
+                    self.shortening_hessian(s, |r, c, v| hess[(r, c)] += sign * e.dot(&v));
                 }
             }
         }

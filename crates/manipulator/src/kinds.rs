@@ -23,6 +23,7 @@
 //! lumped_stiffness = "k_c"            # N/m, with "springs"
 //! lumped_damping = "c_c"              # N·s/m, with "springs"
 //! paper_reactions = false             # also publish rho{k}_paper (springs only)
+//! geometric_stiffening = false        # keep the axial shortening of the bent links
 //! ```
 //!
 //! Links are numbered from 1 as in the paper. A link table has `type` = `"beam"` (length, E,
@@ -35,7 +36,7 @@ use bondgraph::kind::{BuildError, KindDecl, ParamDecl, Params, Range};
 use bondgraph::{Composite, ParamError};
 
 use crate::actuator::LinearActuator;
-use crate::link::{Link, PointMass};
+use crate::link::{Link, PointMass, Profile};
 use crate::lumped_mass::LumpedMass;
 use crate::pin::Pin;
 use crate::quadrature::GaussLegendre;
@@ -89,6 +90,24 @@ const LINK: &[ParamDecl] = &[
         .non_negative()
         .optional("pendulum only"),
     ParamDecl::tables("point_masses", POINT_MASS, "point masses on the link").optional("none"),
+    ParamDecl::vector(
+        "EI_samples",
+        "N·m²",
+        "EI(x) sampled at equally spaced x from 0 to L, linear between (beam; replaces E·I)",
+    )
+    .optional("uniform"),
+    ParamDecl::vector(
+        "rhoA_samples",
+        "kg/m",
+        "ρA(x) sampled likewise (beam; replaces rho·A)",
+    )
+    .optional("uniform"),
+    ParamDecl::vector(
+        "rhoI_samples",
+        "kg·m",
+        "ρI(x) sampled likewise (beam; replaces rho·I)",
+    )
+    .optional("uniform"),
 ];
 
 const PIN: &[ParamDecl] = &[
@@ -131,6 +150,7 @@ pub const PLANAR_ARM: KindDecl = KindDecl::composite(
         ParamDecl::number("lumped_stiffness", "N/m", "spring stiffness of lumped masses (with \"springs\")").positive().optional("needed with springs"),
         ParamDecl::number("lumped_damping", "N·s/m", "spring damping of lumped masses (with \"springs\")").non_negative().default(0.0),
         ParamDecl::flag("paper_reactions", false, "also publish rho{k}_paper (springs only)"),
+        ParamDecl::flag("geometric_stiffening", false, "keep the axial shortening of bent links (axial-force stiffening; docs/manipulator.md)"),
     ],
     build_planar_arm,
 )
@@ -160,7 +180,20 @@ fn link(k: usize, t: &dyn Params) -> Result<Link, BuildError> {
     };
     let mut l = match kind.as_str() {
         "rigid" => {
-            only(&["E", "rho", "A", "I", "modes", "mass"], "rigid")?;
+            only(
+                &[
+                    "E",
+                    "rho",
+                    "A",
+                    "I",
+                    "modes",
+                    "mass",
+                    "EI_samples",
+                    "rhoA_samples",
+                    "rhoI_samples",
+                ],
+                "rigid",
+            )?;
             let (m, j) = (
                 t.number("mass_per_length")?,
                 t.number("rotary_inertia_per_length")?,
@@ -179,6 +212,9 @@ fn link(k: usize, t: &dyn Params) -> Result<Link, BuildError> {
                     "modes",
                     "mass_per_length",
                     "rotary_inertia_per_length",
+                    "EI_samples",
+                    "rhoA_samples",
+                    "rhoI_samples",
                 ],
                 "pendulum",
             )?;
@@ -197,6 +233,23 @@ fn link(k: usize, t: &dyn Params) -> Result<Link, BuildError> {
                 t.number("I")?,
             )
             .map_err(fail())?;
+            let samples = |key: &str| -> Result<Option<Vec<f64>>, BuildError> {
+                if t.has(key) {
+                    Ok(Some(t.vector(key)?))
+                } else {
+                    Ok(None)
+                }
+            };
+            let profile = Profile {
+                bending_stiffness: samples("EI_samples")?,
+                mass_per_length: samples("rhoA_samples")?,
+                rotary_inertia_per_length: samples("rhoI_samples")?,
+            };
+            let beam = if profile == Profile::default() {
+                beam
+            } else {
+                beam.with_profile(profile).map_err(fail())?
+            };
             beam.with_sine_modes(t.count("modes")? as u32)
                 .map_err(fail())?
         }
@@ -244,6 +297,11 @@ fn scene(p: &dyn Params) -> Result<ArmScene, BuildError> {
         .enumerate()
         .map(|(k, t)| link(k, t.as_ref()))
         .collect::<Result<Vec<_>, _>>()?;
+    let stiffening = p.flag("geometric_stiffening")?;
+    let links: Vec<Link> = links
+        .into_iter()
+        .map(|l| l.with_geometric_stiffening(stiffening))
+        .collect();
     if links.is_empty() {
         return Err(BuildError::missing(
             "links",

@@ -84,6 +84,9 @@ impl ArmKinematics<'_> {
                 }
             }
         }
+        if arm.has_geometric_stiffening() {
+            self.add_stiffening_kinetic(u, e, mdot_u);
+        }
     }
 
     /// Accelerations `u̇ = M⁻¹(ṗ − Ṁ u)` given the momentum rate ṗ (eq. 43), or `None` if M is

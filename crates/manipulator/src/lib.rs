@@ -35,6 +35,11 @@
 //! ## Reaction forces (section 5)
 //! [`ArmKinematics::reactions`] (eqs. 84–98) with [`PointLoad`]s.
 //!
+//! ## Beyond the paper's beam
+//! [`geometric_stiffening`]: a link option keeping the second-order axial shortening of the
+//! bent link in the positions of its points, pins and chord end (axial-force stiffening),
+//! with its precomputed [`ShorteningIntegrals`]; [`CantileverMode`]s for the last link.
+//!
 //! ## Bond-graph elements (section 4)
 //! [`elements`]: the I-field ([`ArmInertia`]), C-field ([`ArmCompliance`]), R-field
 //! ([`ArmDamping`]), the MTFs to the cylinders ([`ActuatorTransformer`]) and to the lumped
@@ -57,6 +62,9 @@ pub mod pin;
 pub mod projection;
 pub mod quadrature;
 pub mod shape_integrals;
+
+// Beyond the paper's beam
+pub mod geometric_stiffening;
 
 // Dynamics (section 3.2)
 mod cholesky;
@@ -88,12 +96,13 @@ pub use elements::{
     lumped_masses, ActuatorTransformer, ArmCompliance, ArmDamping, ArmInertia, ArmReactions,
     LumpedGravity, LumpedMassTransformer,
 };
+pub use geometric_stiffening::ShorteningIntegrals;
 pub use joint::RevoluteJoint;
 pub use kinds::KINDS;
 pub use kinematics::ArmKinematics;
-pub use link::{Link, PointMass};
+pub use link::{Link, PointMass, Profile};
 pub use lumped_mass::LumpedMass;
-pub use mode_shape::{ModeShape, SineMode};
+pub use mode_shape::{CantileverMode, ModeShape, SineMode};
 pub use pin::{Pin, PinPoint};
 pub use projection::Projection;
 pub use quadrature::GaussLegendre;

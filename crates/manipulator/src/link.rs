@@ -13,7 +13,7 @@
 
 use std::sync::Arc;
 
-use crate::mode_shape::{ModeShape, SineMode};
+use crate::mode_shape::{CantileverMode, ModeShape, SineMode};
 use bondgraph::ParamError;
 
 /// A point mass on the deformed axis of a link, at distance `x` along the chord.
@@ -36,6 +36,31 @@ pub struct Link {
     bending_stiffness: f64,
     modes: Vec<Arc<dyn ModeShape>>,
     masses: Vec<PointMass>,
+    geometric_stiffening: bool,
+    free_end: bool,
+    profile: Option<Arc<Profile>>,
+}
+
+/// Properties that vary along the chord (a tapered boom): each one, if given, as values
+/// sampled at equally spaced x from 0 to L (at least two), interpolated linearly; otherwise
+/// the link's uniform value. [`Link::with_profile`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Profile {
+    /// EI(x) (N·m²).
+    pub bending_stiffness: Option<Vec<f64>>,
+    /// ρA(x) (kg/m).
+    pub mass_per_length: Option<Vec<f64>>,
+    /// ρI(x) (kg·m).
+    pub rotary_inertia_per_length: Option<Vec<f64>>,
+}
+
+/// The linear interpolation at x ∈ [0, L] of values sampled at equally spaced points.
+fn sampled(v: &[f64], length: f64, x: f64) -> f64 {
+    let n = v.len() - 1;
+    let t = (x / length).clamp(0.0, 1.0) * n as f64;
+    let k = (t.floor() as usize).min(n - 1);
+    let f = t - k as f64;
+    v[k] + f * (v[k + 1] - v[k])
 }
 
 impl Link {
@@ -49,6 +74,9 @@ impl Link {
             bending_stiffness: 0.0,
             modes: Vec::new(),
             masses: Vec::new(),
+            geometric_stiffening: false,
+            free_end: false,
+            profile: None,
         })
     }
 
@@ -98,6 +126,26 @@ impl Link {
         })
     }
 
+    /// Add the first `n` clamped–free modes ([`CantileverMode`]): the link must be the last
+    /// of its arm (its end carries no joint; [`PlanarArm`](crate::PlanarArm) checks it), and
+    /// its joint angle is then the angle of its root cross-section.
+    pub fn with_cantilever_modes(mut self, n: u32) -> Result<Self, ParamError> {
+        ParamError::positive("EI", self.bending_stiffness)?;
+        let l = self.length;
+        for k in 1..=n {
+            self.modes.push(Arc::new(CantileverMode::new(k, l)));
+        }
+        self.free_end = n > 0;
+        Ok(self)
+    }
+
+    /// Whether the link's modes move the end of its chord (cantilever modes): it must be the
+    /// last link.
+    #[must_use]
+    pub fn has_free_end(&self) -> bool {
+        self.free_end
+    }
+
     /// Add an assumed mode. It must vanish at both ends of the chord (chord-to-chord joint
     /// angles), and the link must have a bending stiffness.
     pub fn with_mode(mut self, mode: Arc<dyn ModeShape>) -> Result<Self, ParamError> {
@@ -121,6 +169,100 @@ impl Link {
         Ok(self)
     }
 
+    /// Keep (`true`) the second-order axial shortening of the bent link,
+    /// `u(x) = −½∫₀ˣ (∂w/∂ξ)² dξ`, in the position of its material points, its pins and the
+    /// end of its chord ([`geometric_stiffening`](crate::geometric_stiffening)). Off by default
+    /// (the paper's beam); no effect on a rigid link.
+    #[must_use]
+    pub fn with_geometric_stiffening(mut self, on: bool) -> Self {
+        self.geometric_stiffening = on;
+        self
+    }
+
+    /// Let EI, ρA and/or ρI vary along the chord ([`Profile`]): the link's shape integrals
+    /// are then computed by quadrature (at least 64 points), with the link's own assumed modes
+    /// (sines, or cantilever modes) as a Ritz basis. Set the profile before adding modes.
+    pub fn with_profile(mut self, profile: Profile) -> Result<Self, ParamError> {
+        for (name, v, positive) in [
+            ("EI(x)", &profile.bending_stiffness, true),
+            ("rhoA(x)", &profile.mass_per_length, false),
+            ("rhoI(x)", &profile.rotary_inertia_per_length, false),
+        ] {
+            if let Some(v) = v {
+                if v.len() < 2 {
+                    return Err(ParamError::shape(
+                        name,
+                        "needs at least two samples (at x = 0 and x = L, equally spaced)",
+                    ));
+                }
+                for &x in v {
+                    if positive {
+                        ParamError::positive(name, x)?;
+                    } else {
+                        ParamError::non_negative(name, x)?;
+                    }
+                }
+            }
+        }
+        let mean = |v: &[f64]| {
+            let n = (v.len() - 1) as f64;
+            (v.iter().sum::<f64>() - 0.5 * (v[0] + v[v.len() - 1])) / n
+        };
+        if let Some(v) = &profile.bending_stiffness {
+            self.bending_stiffness = mean(v);
+        }
+        if let Some(v) = &profile.mass_per_length {
+            self.mass_per_length = mean(v);
+        }
+        if let Some(v) = &profile.rotary_inertia_per_length {
+            self.rotary_inertia_per_length = mean(v);
+        }
+        self.profile = Some(Arc::new(profile));
+        Ok(self)
+    }
+
+    /// Whether EI, ρA and ρI are the same all along the chord.
+    #[must_use]
+    pub fn is_uniform(&self) -> bool {
+        self.profile.is_none()
+    }
+    /// ρA at x (kg/m).
+    #[must_use]
+    pub fn mass_per_length_at(&self, x: f64) -> f64 {
+        match self
+            .profile
+            .as_deref()
+            .and_then(|p| p.mass_per_length.as_deref())
+        {
+            Some(v) => sampled(v, self.length, x),
+            None => self.mass_per_length,
+        }
+    }
+    /// ρI at x (kg·m).
+    #[must_use]
+    pub fn rotary_inertia_per_length_at(&self, x: f64) -> f64 {
+        match self
+            .profile
+            .as_deref()
+            .and_then(|p| p.rotary_inertia_per_length.as_deref())
+        {
+            Some(v) => sampled(v, self.length, x),
+            None => self.rotary_inertia_per_length,
+        }
+    }
+    /// EI at x (N·m²).
+    #[must_use]
+    pub fn bending_stiffness_at(&self, x: f64) -> f64 {
+        match self
+            .profile
+            .as_deref()
+            .and_then(|p| p.bending_stiffness.as_deref())
+        {
+            Some(v) => sampled(v, self.length, x),
+            None => self.bending_stiffness,
+        }
+    }
+
     /// Add a point mass on the deformed axis.
     pub fn with_point_mass(mut self, m: PointMass) -> Result<Self, ParamError> {
         if !(m.x.is_finite() && (0.0..=self.length).contains(&m.x)) {
@@ -141,7 +283,7 @@ impl Link {
     pub fn length(&self) -> f64 {
         self.length
     }
-    /// Mass per length ρA (kg/m).
+    /// Mass per length ρA (kg/m); its mean along the chord with a [`Profile`].
     #[must_use]
     pub fn mass_per_length(&self) -> f64 {
         self.mass_per_length
@@ -165,6 +307,11 @@ impl Link {
     #[must_use]
     pub fn point_masses(&self) -> &[PointMass] {
         &self.masses
+    }
+    /// Whether the axial shortening of the bent link is kept (and it has modes).
+    #[must_use]
+    pub fn geometric_stiffening(&self) -> bool {
+        self.geometric_stiffening && !self.modes.is_empty()
     }
     /// Whether the link has no modes.
     #[must_use]

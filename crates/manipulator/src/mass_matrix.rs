@@ -68,6 +68,9 @@ impl ArmKinematics<'_> {
                 }
             }
         }
+        if arm.has_geometric_stiffening() {
+            self.add_stiffening_mass(m);
+        }
     }
 
     /// T = ½ uᵀ M u (eq. 41) at speeds `u`.
@@ -96,6 +99,9 @@ impl ArmKinematics<'_> {
                 }
             }
             t += 0.5 * (translation + rotation);
+        }
+        if arm.has_geometric_stiffening() {
+            t += self.stiffening_kinetic_energy(u);
         }
         t
     }

@@ -35,6 +35,7 @@
 
 use nalgebra::DMatrix;
 
+use crate::geometric_stiffening::ShorteningIntegrals;
 use crate::link::Link;
 use crate::mode_shape::ModeShape;
 use crate::quadrature::GaussLegendre;
@@ -49,6 +50,8 @@ pub struct ShapeIntegrals {
     rotation: DMatrix<f64>,
     /// K of the link's modes, m × m.
     bending: DMatrix<f64>,
+    /// With geometric stiffening: the integrals of the shortening.
+    shortening: Option<ShorteningIntegrals>,
 }
 
 /// The ρA-weighted moments of a link's deflection at (q, u) that the dynamics need:
@@ -91,8 +94,13 @@ impl ShapeIntegrals {
             translation: DMatrix::zeros(m + 2, m + 2),
             rotation: DMatrix::zeros(m + 1, m + 1),
             bending: DMatrix::zeros(m, m),
+            shortening: None,
         };
-        let sines: Option<Vec<f64>> = link.modes().iter().map(|p| p.sine_wavenumber()).collect();
+        let sines: Option<Vec<f64>> = if link.is_uniform() {
+            link.modes().iter().map(|p| p.sine_wavenumber()).collect()
+        } else {
+            None
+        };
         match sines {
             Some(kappa) => s.add_sines(link, &kappa),
             None => s.add_quadrature(
@@ -105,6 +113,9 @@ impl ShapeIntegrals {
             features(link.modes(), pm.x, &mut phi, &mut chi);
             add_outer(&mut s.translation, pm.mass, &phi);
             add_outer(&mut s.rotation, pm.inertia, &chi);
+        }
+        if link.geometric_stiffening() {
+            s.shortening = Some(ShorteningIntegrals::of(link, points)?);
         }
         Ok(s)
     }
@@ -148,13 +159,13 @@ impl ShapeIntegrals {
             for (c, mode) in curv.iter_mut().zip(link.modes()) {
                 *c = mode.curvature(x);
             }
-            add_outer(&mut self.translation, w * link.mass_per_length(), &phi);
+            add_outer(&mut self.translation, w * link.mass_per_length_at(x), &phi);
             add_outer(
                 &mut self.rotation,
-                w * link.rotary_inertia_per_length(),
+                w * link.rotary_inertia_per_length_at(x),
                 &chi,
             );
-            add_outer(&mut self.bending, w * link.bending_stiffness(), &curv);
+            add_outer(&mut self.bending, w * link.bending_stiffness_at(x), &curv);
         }
     }
 
@@ -172,6 +183,12 @@ impl ShapeIntegrals {
     #[must_use]
     pub fn bending(&self) -> &DMatrix<f64> {
         &self.bending
+    }
+    /// The integrals of the axial shortening, if the link keeps it
+    /// ([`geometric_stiffening`](crate::geometric_stiffening)).
+    #[must_use]
+    pub fn shortening(&self) -> Option<&ShorteningIntegrals> {
+        self.shortening.as_ref()
     }
     /// Number of modes m.
     #[must_use]

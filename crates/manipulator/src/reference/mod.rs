@@ -61,8 +61,8 @@ impl<'a> StationKinematics<'a> {
                 for (x, w) in arm.quadrature().on(link.length()) {
                     stations.push(MassStation {
                         station: arm.station_unchecked(i, x),
-                        mass: w * link.mass_per_length(),
-                        inertia: w * link.rotary_inertia_per_length(),
+                        mass: w * link.mass_per_length_at(x),
+                        inertia: w * link.rotary_inertia_per_length_at(x),
                     });
                 }
             }
@@ -121,7 +121,7 @@ pub fn stiffness_matrix(arm: &PlanarArm) -> DMatrix<f64> {
             let c: Vec<f64> = modes.iter().map(|m| m.curvature(x)).collect();
             for a in 0..modes.len() {
                 for b in 0..modes.len() {
-                    k[(o + a, o + b)] += link.bending_stiffness() * w * c[a] * c[b];
+                    k[(o + a, o + b)] += link.bending_stiffness_at(x) * w * c[a] * c[b];
                 }
             }
         }
