@@ -3,7 +3,7 @@
 
 use nalgebra::DMatrix;
 
-use super::{Block, Cell, JacobianWork, EMPTY};
+use super::{Block, Cell, JacobianWork, Out, EMPTY};
 use crate::equations::{Probe, StateEquations};
 
 impl StateEquations {
@@ -92,7 +92,7 @@ impl StateEquations {
         }
         for (id, l) in self.layouts.iter().enumerate() {
             if l.n_states > 0 {
-                block.derivatives(id, jac);
+                block.derivatives(id, &mut Out::Dense(jac));
             }
         }
         let nb = self.n_bond_values;
