@@ -169,3 +169,52 @@ b1 = "feed -> tank"
     eqs.rhs(0.0, &x, &mut dx);
     assert_eq!((dx[q], dx[y]), (-3.0, -2.0));
 }
+
+/// `[inputs] F = { file = …, column = … }`: the data drive the run; data that end before
+/// `t_end` are refused naming that end, unless `extrapolate = "hold"`.
+#[test]
+fn an_input_from_a_data_file_named_in_the_model() {
+    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../data/msd_force_step.csv");
+    let text = format!(
+        r#"
+[inputs]
+F = {{ file = "{data}", column = "F", interp = "hold" }}
+[elements]
+force  = {{ kind = "Se", e = "F" }}
+v      = {{ kind = "1" }}
+mass   = {{ kind = "I", m = 1.0 }}
+spring = {{ kind = "C", k = 100.0 }}
+damper = {{ kind = "R", r = 2.0 }}
+[bonds]
+b0 = "force -> v"
+b1 = "v -> mass"
+b2 = "v -> spring"
+b3 = "v -> damper"
+[simulation]
+t_end = 20.0
+dt_out = 0.1
+rtol = 1e-10
+atol = 1e-13
+[outputs]
+x = "spring.q"
+"#
+    );
+    let mut m = load(&text).unwrap();
+    assert_eq!(m.equations.input_breakpoints(0).unwrap(), [0.0, 1.0, 20.0]);
+    let out = m.run().unwrap();
+    assert!(out.error.is_none(), "{:?}", out.error);
+    let x = out.trajectory.column("x").unwrap();
+    assert!((x.last().unwrap() - 0.1).abs() < 1e-6);
+    let long = text.replace("t_end = 20.0", "t_end = 30.0");
+    let e = load(&long).unwrap_err();
+    assert!(
+        e.message.contains("before the run's end t_end = 30 s"),
+        "{e}"
+    );
+    assert_eq!(e.line, Some(4), "{e}");
+    let held = long.replace(
+        "interp = \"hold\"",
+        "interp = \"hold\", extrapolate = \"hold\"",
+    );
+    assert!(load(&held).is_ok());
+}
