@@ -1,7 +1,7 @@
 //! `bg-sim linearize`: the crane's poles are those of `bg-sim modes`; the mass–spring–damper
 //! with a force input has poles −1 ± 9.95i and DC gain 1/k; Bode data and figure; bad
 //! requests exit with status 2.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -154,7 +154,10 @@ fn msd_force_input_poles_dc_gain_and_bode() {
     assert_eq!(poles.len(), 2);
     for p in poles {
         let (re, im) = (p["re"].as_f64().unwrap(), p["im"].as_f64().unwrap());
-        assert!((re + 1.0).abs() < 1e-12 && (im.abs() - wd).abs() < 1e-12, "{p}");
+        assert!(
+            (re + 1.0).abs() < 1e-12 && (im.abs() - wd).abs() < 1e-12,
+            "{p}"
+        );
     }
     assert!(format!("{wd:.2}") == "9.95");
     let dc = lin["dc_gain"][0][0].as_f64().unwrap();
@@ -167,12 +170,23 @@ fn msd_force_input_poles_dc_gain_and_bode() {
     let png = dir.join("bode.png");
     let out = bg_sim()
         .current_dir(root())
-        .args(["linearize", "models/msd_force.toml", "--bode", "F:x", "--freq", "0.1..100"])
+        .args([
+            "linearize",
+            "models/msd_force.toml",
+            "--bode",
+            "F:x",
+            "--freq",
+            "0.1..100",
+        ])
         .args(["--points", "50", "--format", "csv", "--plot"])
         .arg(&png)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = String::from_utf8(out.stdout).unwrap();
     let mut lines = text.lines();
     assert_eq!(lines.next(), Some("f_hz,magnitude,db,phase_deg"));

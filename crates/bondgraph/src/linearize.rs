@@ -189,7 +189,7 @@ pub fn log_frequencies(lo: f64, hi: f64, count: usize) -> Vec<f64> {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(clippy::unwrap_used, clippy::float_cmp)] // exact values by intent
     use super::*;
     use crate::{assign_causality, BondGraph, Capacitor, EffortSource, Inertia, OneJunction};
     use crate::{Resistor, StateEquations};

@@ -59,15 +59,11 @@ pub fn bode(
         top.titled(title, (FONT, 20).into_font().style(FontStyle::Bold))
             .map_err(|e| fail(&e))?;
         let (upper, lower) = body.split_vertically((640 - TITLE_HEIGHT) / 2);
-        let panels: [(
-            &DrawingArea<_, _>,
-            &str,
-            (f64, f64),
-            fn(&BodePoint) -> f64,
-            bool,
-        ); 2] = [
-            (&upper, "magnitude [dB]", (m0, m1), |p| p.db, false),
-            (&lower, "phase [°]", (p0, p1), |p| p.phase_deg, true),
+        let magnitude: fn(&BodePoint) -> f64 = |p| p.db;
+        let phase: fn(&BodePoint) -> f64 = |p| p.phase_deg;
+        let panels = [
+            (&upper, "magnitude [dB]", (m0, m1), magnitude, false),
+            (&lower, "phase [°]", (p0, p1), phase, true),
         ];
         for (k, (area, label, (y0, y1), value, last)) in panels.into_iter().enumerate() {
             let mut chart = ChartBuilder::on(area)

@@ -442,7 +442,7 @@ fn apply(eqs: &mut StateEquations, ev: Event) -> Result<(), SimulationError> {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(clippy::unwrap_used, clippy::float_cmp)] // exact values by intent
     use super::*;
     use crate::{
         assign_causality, simulate, BondGraph, Capacitor, EffortSource, Inertia, OneJunction,

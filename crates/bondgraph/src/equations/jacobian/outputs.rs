@@ -130,7 +130,7 @@ impl StateEquations {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(clippy::unwrap_used, clippy::float_cmp)] // exact values by intent
     use crate::{
         assign_causality, BondGraph, Capacitor, EffortSource, Inertia, OneJunction, Resistor,
         StateEquations,
