@@ -224,7 +224,10 @@ impl Reference {
                 } else {
                     interpolate(&self.t, vals, row[0])
                 };
-                let e = (row[k] - reference).abs() / scale;
+                // A column that is exactly zero in the reference (scale 0) scores 0 where the
+                // run equals it and infinity where it does not (compare then names it).
+                let d = (row[k] - reference).abs();
+                let e = if d == 0.0 { 0.0 } else { d / scale };
                 if e.is_nan() || e > worst {
                     worst = e;
                     if e.is_nan() {
@@ -284,7 +287,7 @@ pub fn unscorable<'a>(
                 "{file}: column `{name}` spans {lo:e} to {hi:e}, a range that overflows f64: its errors cannot be scaled"
             ));
         }
-        if let Some(s) = scale.filter(|s| !(s.is_finite() && *s > 0.0)) {
+        if let Some(s) = scale.filter(|s| !(s.is_finite() && *s >= 0.0)) {
             return Err(format!(
                 "{file}: column `{name}` has the scale {s:e} (its range and mean in the reference): its errors cannot be scaled\n  hint: give it an error floor, e.g. --floor {name}=1e-9"
             ));

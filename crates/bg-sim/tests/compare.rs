@@ -32,7 +32,6 @@ fn a_column_that_cannot_be_scored_fails_naming_it_and_why() {
         ("t,x,y\n0,1,inf\n1,2,3\n", "holds inf"),
         ("t,x,y\n0,1,-inf\n1,2,3\n", "holds -inf"),
         ("t,x,y\n0,1,1e308\n1,2,-1e308\n", "overflows f64"),
-        ("t,x,y\n0,1,0\n1,2,0\n", "scale 0e0"),
     ] {
         let (code, out, err) = compare(text, text, &[]);
         assert_eq!(code, Some(2), "{text}: {out}{err}");
@@ -54,8 +53,21 @@ fn a_column_that_cannot_be_scored_fails_naming_it_and_why() {
     let (code, _, err) = compare("t,x\nNaN,1\n1,2\n", "t,x\n0,1\n1,2\n", &[]);
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("column `t`"), "{err}");
-    // a zero column scores with a floor
+    // a column that is zero in the reference: equal, it scores 0; different, it cannot be
+    // scaled (the hint names the floor); with a floor it scores
     let zero = "t,x,y\n0,1,0\n1,2,0\n";
+    let (code, out, err) = compare(zero, zero, &[]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(out.contains("worst: "), "{out}");
+    let (code, out, err) = compare("t,x,y\n0,1,0\n1,2,1e-12\n", zero, &[]);
+    assert_eq!(code, Some(2), "{out}{err}");
+    assert!(
+        err.contains("column `y`") && err.contains("scale 0e0") && err.contains("--floor y="),
+        "{err}"
+    );
+    let (code, out, err) = compare("t,x,y\n0,1,0\n1,2,1e-12\n", zero, &["--floor", "y=1e-9"]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(out.contains("worst: "), "{out}");
     let (code, out, err) = compare(zero, zero, &["--floor", "y=1e-9"]);
     assert_eq!(code, Some(0), "{err}");
     assert!(out.contains("worst: "), "{out}");

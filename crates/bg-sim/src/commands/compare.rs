@@ -59,9 +59,16 @@ fn compare(
             )
         })?;
         if let Some((name, e)) = errors.iter().find(|(_, e)| !e.is_finite()) {
-            return Err(format!(
-                "the error of column `{name}` is {e}: the comparison cannot be scored"
-            ));
+            let zero = r.columns.iter().any(|c| &c.0 == name && c.2 == 0.0);
+            return Err(if zero {
+                format!(
+                    "column `{name}` is zero throughout {} (scale 0e0) but not in {}: its errors cannot be scaled\n  hint: give it an error floor, e.g. --floor {name}=1e-9",
+                    reference.display(),
+                    results.display()
+                )
+            } else {
+                format!("the error of column `{name}` is {e}: the comparison cannot be scored")
+            });
         }
         Ok((r, errors))
     });
