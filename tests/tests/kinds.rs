@@ -236,3 +236,112 @@ t_end = 1.0
     );
     assert_positioned(&k, &e, "wrong unit");
 }
+
+/// The symbol a parameter's doc line gives it: its last word before any parenthesis when
+/// that word is one letter, optionally subscripted, and follows a noun (`x` in "relative
+/// opening x (not clamped)"); after an operator or a preposition ("l = l0 + s", "1 P to A",
+/// "at p_max") the word names something else.
+fn doc_symbol(doc: &str) -> Option<&str> {
+    const NOT_NOUNS: [&str; 8] = ["to", "at", "of", "from", "by", "and", "or", "passes"];
+    let head = doc.split('(').next().unwrap_or(doc);
+    let mut words = head.split_whitespace().rev();
+    let last = words.next()?;
+    let before = words.next()?;
+    let noun = before.chars().all(char::is_alphabetic) && !NOT_NOUNS.contains(&before);
+    let mut parts = last.splitn(2, '_');
+    let letter = parts.next()?;
+    let short = letter.chars().count() == 1 && letter.chars().all(char::is_alphabetic);
+    (noun && short && parts.next().is_none_or(|s| !s.is_empty())).then_some(last)
+}
+
+/// The ASCII words of a law (`Q`, `x`, `regRoot`, `P_a`): maximal runs of letters, digits
+/// and `_`; Greek letters, sub- and superscripts and operators separate them.
+fn law_words(law: &str) -> Vec<&str> {
+    law.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+        .filter(|w| !w.is_empty())
+        .collect()
+}
+
+/// Every law row of the docs: (file, line, kind, law) for each table row whose first cell
+/// names kinds in backticks, in a table with a `law` column.
+fn law_rows() -> Vec<(String, usize, String, String)> {
+    let mut rows = Vec::new();
+    for path in docs() {
+        let text = std::fs::read_to_string(&path).unwrap();
+        let file = path.file_name().unwrap().to_string_lossy().into_owned();
+        let mut law_col = None;
+        for (i, line) in text.lines().enumerate() {
+            if !line.starts_with('|') {
+                law_col = None;
+                continue;
+            }
+            let cells: Vec<&str> = line.trim_matches('|').split('|').map(str::trim).collect();
+            if law_col.is_none() {
+                law_col = cells.iter().position(|c| *c == "law");
+                continue;
+            }
+            let Some(col) = law_col else { continue };
+            for kind in cells[0].split(',').map(str::trim) {
+                if let Some(k) = kind.strip_prefix('`').and_then(|k| k.strip_suffix('`')) {
+                    if let Some(law) = cells.get(col) {
+                        rows.push((file.clone(), i + 1, k.to_owned(), (*law).to_owned()));
+                    }
+                }
+            }
+        }
+    }
+    rows
+}
+
+/// Docs and declarations cannot drift apart on a law's names. The rule: a kind's law — its
+/// row in a docs table with a `law` column, and its declaration's one-line summary — writes
+/// each parameter by its key (`opening`) or by a Greek or literature symbol (α for `alpha`),
+/// never by a second ASCII name. A parameter's ASCII symbol is the last word of its doc line
+/// before any parenthesis when that word is one letter, optionally subscripted (`x` in
+/// "relative opening x"); where it differs from the key, the law must not use it, because the
+/// model file spells it otherwise (issue 24 item 3: the orifice's law wrote `x` for
+/// `opening`). Other ASCII words of a law (port efforts and flows `P_a`, `Q`, states,
+/// functions such as `regRoot`) are not parameters and pass. Rows naming element types
+/// that are not registered kinds (the arm's internal fields in `manipulator.md`) are skipped.
+#[test]
+fn every_law_names_its_parameters_by_their_keys() {
+    let kinds = kinds();
+    let mut problems = Vec::new();
+    let mut laws: Vec<(String, &KindDecl, String)> = Vec::new();
+    for (file, line, kind, law) in law_rows() {
+        if let Some(k) = kinds.iter().find(|k| k.name == kind) {
+            laws.push((format!("{file}:{line}"), k, law));
+        }
+    }
+    for k in &kinds {
+        laws.push((
+            format!("declaration of {}", k.name),
+            k,
+            k.summary.to_owned(),
+        ));
+    }
+    let mut checked = 0;
+    for (at, k, law) in &laws {
+        let words = law_words(law);
+        for d in k.params {
+            let Some(sym) = doc_symbol(d.doc) else {
+                continue;
+            };
+            if sym != d.name && words.contains(&sym) {
+                problems.push(format!(
+                    "{at}: the law of {} writes `{sym}` for the parameter `{}` (\"{}\"): write `{}`",
+                    k.name, d.name, d.doc, d.name
+                ));
+            }
+            checked += 1;
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+    let rows = laws.len() - kinds.len();
+    assert!(
+        rows >= 25,
+        "only {rows} law rows found in the docs: did the tables move?"
+    );
+    assert!(checked >= 20, "only {checked} parameter symbols checked");
+    assert_eq!(doc_symbol("relative opening x (not clamped)"), Some("x"));
+}

@@ -1,5 +1,6 @@
 //! Orifice `hydraulics.orifice`: turbulent flow through a (possibly modulated) opening,
-//! `Q = α·x·regRoot(P_a − P_b)` from port `a` to port `b` (paper eqs. 29–31).
+//! `Q = α·opening·regRoot(P_a − P_b)` from port `a` to port `b` (paper eqs. 29–31, where
+//! the opening is x).
 //!
 //! The square root of the orifice law has an infinite slope at Δp = 0, which a stiff solver
 //! sees as an infinite Jacobian entry. It is regularised as in Modelica.Fluid's `regRoot`:
@@ -51,7 +52,7 @@ pub fn alpha(cd: f64, w: f64, rho: f64) -> Result<f64, ParamError> {
     Ok(cd * w * (2.0 / rho).sqrt())
 }
 
-/// Two-port orifice: `Q = α·x·regRoot(P_a − P_b)` flows from `a` to `b`.
+/// Two-port orifice: `Q = α·opening·regRoot(P_a − P_b)` flows from `a` to `b`.
 ///
 /// * `alpha` — orifice coefficient α, m³/(s·√Pa), > 0 (see [`alpha`]).
 /// * `opening` — relative opening x (dimensionless, may be modulated); not clamped.
@@ -186,7 +187,7 @@ pub fn alpha_of(p: &dyn Params) -> Result<f64, BuildError> {
 /// Kind `hydraulics.orifice`.
 pub const KIND: KindDecl = KindDecl::element(
     "hydraulics.orifice",
-    "orifice a → b: Q = α·x·regRoot(P_a − P_b)",
+    "orifice a → b: Q = α·opening·regRoot(P_a − P_b)",
     &[
         ALPHA,
         CD,
