@@ -99,7 +99,7 @@ impl StateEquations {
                 }
                 let lb = self.read(crate::Probe::Signal(*ooff), t, x);
                 let tol = LENGTH_TOLERANCE_ABS + LENGTH_TOLERANCE_REL * la.abs().max(lb.abs());
-                if !((la - lb).abs() <= tol) {
+                if (la - lb).abs() > tol || (la - lb).is_nan() {
                     out.push(LengthMismatch {
                         a: (id, name.clone()),
                         a_length: la,
