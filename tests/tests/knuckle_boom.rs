@@ -896,3 +896,36 @@ fn the_run_writes_the_design_page_columns() {
     assert!((p["l1_0"] - 13f64.sqrt()).abs() < 1e-12 && (p["l2_0"] - 13f64.sqrt()).abs() < 1e-12);
     assert!((p["s_max"] - 2.7).abs() < 1e-12);
 }
+
+/// Issue 24, item 2: a cylinder 0.54 m longer than the distance between its pins in the
+/// initial pose cannot be assembled; the load refuses it (it ran before), naming the
+/// cylinder, both lengths, the difference and the fix.
+#[test]
+fn a_cylinder_that_does_not_fit_its_pins_is_refused() {
+    let text = scene_text();
+    let from = r#"s0 = "l1_0 - l0""#;
+    assert!(text.contains(from));
+    let bad = text.replacen(from, r#"s0 = "l1_0 - l0 + 0.54""#, 1);
+    let e = Model::from_text("kb.toml", &bad, &bg_sim::registry(), &[]).unwrap_err();
+    assert_eq!(e.kind, bg_model::ErrorKind::BadParameter, "{e}");
+    assert_eq!(e.element.as_deref(), Some("cyl1"), "{e}");
+    let l_pins = 13f64.sqrt();
+    for part in [
+        "cannot be assembled".to_owned(),
+        format!("{:.6} m long", l_pins + 0.54),
+        format!("{l_pins:.6} m apart"),
+        "differ by 0.540000 m".to_owned(),
+    ] {
+        assert!(e.message.contains(&part), "{part}: {e}");
+    }
+    assert!(
+        e.hint
+            .as_deref()
+            .unwrap_or("")
+            .contains(&format!("s0 = \"{l_pins:.6} - l0\"")),
+        "{e}"
+    );
+    // 0.5 mm off is within the tolerance (1 mm + 1e-6 of the length) and loads
+    let near = text.replacen(from, r#"s0 = "l1_0 - l0 + 0.0005""#, 1);
+    Model::from_text("kb.toml", &near, &bg_sim::registry(), &[]).unwrap_or_else(|e| panic!("{e}"));
+}

@@ -268,6 +268,17 @@ pub trait Element: Debug {
         Vec::new()
     }
 
+    /// Lengths the element has along its scalar mechanical ports, as (port, index into
+    /// [`signal_outputs`](Self::signal_outputs) of the scalar signal holding the length):
+    /// the distance whose rate of change is the port's flow (a cylinder's l = l0 + s, an
+    /// arm's pin distance). Two such ports joined by bonds, directly or through 1-junctions
+    /// (one velocity), describe one distance and must agree at the initial state
+    /// ([`StateEquations::length_mismatches`](crate::StateEquations::length_mismatches)):
+    /// geometry that cannot be assembled is refused before a run.
+    fn port_lengths(&self) -> Vec<(usize, usize)> {
+        Vec::new()
+    }
+
     /// Energy stored at states `x` (for energy-balance tests), if the element stores any.
     fn stored_energy(&self, x: &[f64]) -> Option<f64> {
         let _ = x;

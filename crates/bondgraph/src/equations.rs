@@ -19,6 +19,8 @@ use crate::error::{CausalityError, GraphError};
 use crate::graph::{check_same_shape, BondGraph};
 
 mod inputs;
+mod lengths;
+pub use lengths::{LengthMismatch, LENGTH_TOLERANCE_ABS, LENGTH_TOLERANCE_REL};
 mod jacobian;
 
 /// A named state of the assembled system.

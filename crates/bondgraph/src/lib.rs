@@ -100,7 +100,7 @@ pub use element::{
     Watch,
 };
 pub use elements::*;
-pub use equations::{Probe, StateEquations, StateInfo};
+pub use equations::{LengthMismatch, Probe, StateEquations, StateInfo};
 pub use equilibrium::{
     solve_steady, Condition, Equilibrium, EquilibriumError, Settle, SteadyRequest,
     OWN_SCALE_FRACTION,

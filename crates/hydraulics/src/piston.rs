@@ -107,6 +107,9 @@ impl Element for Piston {
     fn signal_outputs(&self) -> Vec<SignalSpec> {
         vec![SignalSpec::scalar("l")]
     }
+    fn port_lengths(&self) -> Vec<(usize, usize)> {
+        vec![(2, 0)] // port mech: the cylinder length l = l0 + s (its flow is ds/dt)
+    }
     fn stages(&self, _: &[PortCausality]) -> Vec<Stage> {
         vec![
             Stage {

@@ -182,6 +182,14 @@ impl Element for ActuatorTransformer {
             .chain(c.map(|c| SignalSpec::scalar(&format!("ldot{c}"))))
             .collect()
     }
+    fn port_lengths(&self) -> Vec<(usize, usize)> {
+        // port 2 of a single pin pair: the pin distance l (signal `l{c}`), its flow dl/dt
+        if self.pins.len() == 1 {
+            vec![(1, 0)]
+        } else {
+            Vec::new()
+        }
+    }
     fn stages(&self, _: &[PortCausality]) -> Vec<Stage> {
         let n = self.pins.len();
         let mut stages = mtf_law::stages();

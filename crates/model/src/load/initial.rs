@@ -155,3 +155,64 @@ fn flatten_value(
         other => out.push((name.to_owned(), other.clone(), span)),
     }
 }
+
+/// Refuse geometry that cannot be assembled: every pair of lengths of one distance
+/// ([`StateEquations::length_mismatches`]: a cylinder's l0 + s0 and the distance between the
+/// pins it is attached to, in the initial pose) that disagree at the initial state (before
+/// a steady start) by more than 1 mm + 1e-6·length.
+pub(super) fn check_lengths(
+    source: &Source,
+    eqs: &StateEquations,
+    t0: f64,
+    problems: &mut Vec<ModelError>,
+) {
+    let x0 = eqs.initial_state();
+    let entry = |member: &str| {
+        let m = member.rsplit_once('.').map_or(member, |(e, _)| e);
+        source
+            .elements
+            .iter()
+            .find(|e| e.name == m || e.members.iter().any(|n| n == m))
+    };
+    for mm in eqs.length_mismatches(t0, &x0) {
+        let (a, b) = (entry(&mm.a.1), entry(&mm.b.1));
+        let is_cyl = |d: Option<&super::source::ElementDef>| {
+            d.is_some_and(|d| d.kind == "hydraulics.cylinder" || d.params.contains_key("s0"))
+        };
+        // the cylinder (the side with a stroke s0) first
+        let ((cyl, cyl_sig, l_cyl), (other, other_sig, l_other)) = if !is_cyl(a) && is_cyl(b) {
+            ((b, &mm.b.1, mm.b_length), (a, &mm.a.1, mm.a_length))
+        } else {
+            ((a, &mm.a.1, mm.a_length), (b, &mm.b.1, mm.b_length))
+        };
+        let name = |d: Option<&super::source::ElementDef>, sig: &str| {
+            d.map_or_else(|| sig.to_owned(), |d| d.name.clone())
+        };
+        let (cyl_name, other_name) = (name(cyl, cyl_sig), name(other, other_sig));
+        let fix = if is_cyl(cyl) {
+            format!(
+                "give `{cyl_name}` the stroke that fits: s0 = \"{l_other:.6} - l0\" (or from the \
+                 pin geometry, as models/knuckle_boom.toml writes s0 = \"l1_0 - l0\"), or move the \
+                 pins or the initial pose (q0) of `{other_name}`"
+            )
+        } else {
+            format!("change the initial state of `{cyl_name}` or `{other_name}` so that they agree")
+        };
+        problems.push(
+            source
+                .err(
+                    ErrorKind::BadParameter,
+                    cyl.map(|d| &d.name_span),
+                    format!(
+                    "geometry that cannot be assembled: `{cyl_name}` is {l_cyl:.6} m long at the \
+                     start ({cyl_sig}) but the pins it is attached to are {l_other:.6} m apart \
+                     ({other_sig}, `{other_name}` in its initial pose): they differ by {:.6} m, \
+                     more than the tolerance of 1 mm + 1e-6 of the length",
+                    (l_cyl - l_other).abs()
+                ),
+                )
+                .element(&cyl_name)
+                .hint(fix),
+        );
+    }
+}

@@ -72,6 +72,9 @@ pub(super) fn finish(p: Parsed, mut eqs: StateEquations) -> Result<Model, Vec<Mo
     if problems.is_empty() {
         super::inputs::apply_files(&source, &eqs, &settings, &mut problems);
     }
+    if problems.is_empty() {
+        initial::check_lengths(&source, &eqs, settings.t_start, &mut problems);
+    }
     let steady = match steady_spec {
         Some(v) if problems.is_empty() => {
             initial::steady(v, &source, &parameters, &settings, &mut eqs).unwrap_or_else(|e| {
