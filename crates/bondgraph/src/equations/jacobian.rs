@@ -302,6 +302,13 @@ impl StateEquations {
             *jac = DMatrix::zeros(n, n);
         }
         jac.fill(0.0);
+        self.jacobian_into(t, x, &mut Out::Dense(jac));
+    }
+
+    /// One pass of the plan carrying gradients: the derivative rows into `out` (dense or on
+    /// a sparse pattern), which the caller has zeroed.
+    fn jacobian_into(&self, t: f64, x: &[f64], out: &mut Out<'_>) {
+        let n = self.states.len();
         let mut work = self.jac_work.borrow_mut();
         let w = work.get_or_insert_with(|| self.jacobian_work());
         let mut ws = self.ws.borrow_mut();
@@ -322,7 +329,7 @@ impl StateEquations {
         }
         for (id, l) in self.layouts.iter().enumerate() {
             if l.n_states > 0 {
-                block.derivatives(id, &mut Out::Dense(jac));
+                block.derivatives(id, out);
             }
         }
     }

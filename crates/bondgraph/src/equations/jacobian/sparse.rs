@@ -72,31 +72,8 @@ impl StateEquations {
     /// [`jacobian_pattern`](Self::jacobian_pattern)), column by column as
     /// [`SparsePattern::row_idx`]: no n×n matrix. Allocates only on the first call.
     pub fn jacobian_sparse(&self, t: f64, x: &[f64], pattern: &SparsePattern, values: &mut [f64]) {
-        let n = self.states.len();
         values.fill(0.0);
-        let mut work = self.jac_work.borrow_mut();
-        let w = work.get_or_insert_with(|| self.jacobian_work());
-        let mut ws = self.ws.borrow_mut();
-        let ws = &mut *ws;
-        w.x.copy_from_slice(x);
-        w.range.fill(EMPTY);
-        let mut block = Block {
-            eqs: self,
-            t,
-            n,
-            w,
-            effort: &mut ws.effort,
-            flow: &mut ws.flow,
-            signals: &mut ws.signals,
-        };
-        for &(id, stage) in &self.rhs_order {
-            block.stage(id, stage);
-        }
-        for (id, l) in self.layouts.iter().enumerate() {
-            if l.n_states > 0 {
-                block.derivatives(id, &mut Out::Sparse(pattern, values));
-            }
-        }
+        self.jacobian_into(t, x, &mut Out::Sparse(pattern, values));
     }
 }
 
