@@ -92,6 +92,8 @@ pub mod partials_check;
 /// The Radau IIA integrator, from the solver crate (`bg-solver`), re-exported.
 pub use bg_solver::radau;
 pub mod simulate;
+#[cfg(test)]
+mod test_models;
 
 pub use bond::{Bond, BondId, ElementId, Endpoint, PortCausality};
 pub use causality::{assign_causality, CausalGraph};

@@ -191,26 +191,11 @@ pub fn log_frequencies(lo: f64, hi: f64, count: usize) -> Vec<f64> {
 mod tests {
     #![allow(clippy::unwrap_used, clippy::float_cmp)] // exact values by intent
     use super::*;
-    use crate::{assign_causality, BondGraph, Capacitor, EffortSource, Inertia, OneJunction};
-    use crate::{Resistor, StateEquations};
+    use crate::StateEquations;
 
     /// m = 1, k = 100, c = 2 (no input: A and C only).
     fn msd() -> StateEquations {
-        let mut g = BondGraph::new();
-        g.add("force", EffortSource::new(0.0)).unwrap();
-        g.add("v", OneJunction).unwrap();
-        g.add("mass", Inertia::new(1.0, 0.0).unwrap()).unwrap();
-        g.add("spring", Capacitor::new(0.01, 0.0).unwrap()).unwrap();
-        g.add("damper", Resistor::new(2.0).unwrap()).unwrap();
-        for (a, b) in [
-            ("force", "v"),
-            ("v", "mass"),
-            ("v", "spring"),
-            ("v", "damper"),
-        ] {
-            g.connect_names(a, b).unwrap();
-        }
-        StateEquations::new(assign_causality(g).unwrap()).unwrap()
+        crate::test_models::msd(1.0, 0.01, 2.0, 0.0, None)
     }
 
     #[test]
@@ -240,29 +225,7 @@ mod tests {
 
     /// The MSD driven by an input `F` through a modulated effort source.
     fn msd_with_input() -> StateEquations {
-        let mut g = BondGraph::new();
-        let spec = crate::InputSpec {
-            name: "F".into(),
-            unit: "N".into(),
-            default: 0.0,
-            description: "force".into(),
-        };
-        g.add("F", crate::Input::new(spec).unwrap()).unwrap();
-        let force = EffortSource::new(crate::Param::modulated(vec!["F".into()], |_, u| u[0]));
-        g.add("force", force).unwrap();
-        g.add("v", OneJunction).unwrap();
-        g.add("mass", Inertia::new(1.0, 0.0).unwrap()).unwrap();
-        g.add("spring", Capacitor::new(0.01, 0.0).unwrap()).unwrap();
-        g.add("damper", Resistor::new(2.0).unwrap()).unwrap();
-        for (a, b) in [
-            ("force", "v"),
-            ("v", "mass"),
-            ("v", "spring"),
-            ("v", "damper"),
-        ] {
-            g.connect_names(a, b).unwrap();
-        }
-        StateEquations::new(assign_causality(g).unwrap()).unwrap()
+        crate::test_models::msd(1.0, 0.01, 2.0, 0.0, Some(0.0))
     }
 
     /// B = ∂f/∂F and D: exact; the DC gain is 1/k; |G(jω)| = 1/|k − mω² + jcω|; the force

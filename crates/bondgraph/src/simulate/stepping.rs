@@ -444,29 +444,11 @@ fn apply(eqs: &mut StateEquations, ev: Event) -> Result<(), SimulationError> {
 mod tests {
     #![allow(clippy::unwrap_used, clippy::float_cmp)] // exact values by intent
     use super::*;
-    use crate::{
-        assign_causality, simulate, BondGraph, Capacitor, EffortSource, Inertia, OneJunction,
-        Output, Resistor,
-    };
+    use crate::{simulate, EffortSource, Output};
 
     /// m = 1, k = 100, c = 2 pushed by 10 N, from rest.
     fn msd() -> StateEquations {
-        let mut g = BondGraph::new();
-        g.add("force", EffortSource::new(10.0)).unwrap();
-        g.add("v", OneJunction).unwrap();
-        g.add("mass", Inertia::new(1.0, 0.0).unwrap()).unwrap();
-        g.add("spring", Capacitor::new(1.0 / 100.0, 0.0).unwrap())
-            .unwrap();
-        g.add("damper", Resistor::new(2.0).unwrap()).unwrap();
-        for (a, b) in [
-            ("force", "v"),
-            ("v", "mass"),
-            ("v", "spring"),
-            ("v", "damper"),
-        ] {
-            g.connect_names(a, b).unwrap();
-        }
-        StateEquations::new(assign_causality(g).unwrap()).unwrap()
+        crate::test_models::msd(1.0, 1.0 / 100.0, 2.0, 10.0, None)
     }
 
     fn settings() -> Settings {
@@ -570,29 +552,7 @@ mod tests {
     #[test]
     fn an_input_set_between_calls_and_a_series_corner() {
         let s = settings();
-        let mut g = BondGraph::new();
-        let spec = crate::InputSpec {
-            name: "F".into(),
-            unit: "N".into(),
-            default: 10.0,
-            description: String::new(),
-        };
-        g.add("F", crate::Input::new(spec).unwrap()).unwrap();
-        let force = EffortSource::new(crate::Param::modulated(vec!["F".into()], |_, u| u[0]));
-        g.add("force", force).unwrap();
-        g.add("v", OneJunction).unwrap();
-        g.add("mass", Inertia::new(1.0, 0.0).unwrap()).unwrap();
-        g.add("spring", Capacitor::new(0.01, 0.0).unwrap()).unwrap();
-        g.add("damper", Resistor::new(2.0).unwrap()).unwrap();
-        for (a, b) in [
-            ("force", "v"),
-            ("v", "mass"),
-            ("v", "spring"),
-            ("v", "damper"),
-        ] {
-            g.connect_names(a, b).unwrap();
-        }
-        let eqs = StateEquations::new(assign_causality(g).unwrap()).unwrap();
+        let eqs = crate::test_models::msd(1.0, 0.01, 2.0, 0.0, Some(10.0));
         let x0 = eqs.initial_state();
         let probe = eqs.probe("spring.q").unwrap();
         let mut sim = Simulation::start(eqs, 0.0, &x0, &s, vec![]).unwrap();

@@ -131,30 +131,12 @@ impl StateEquations {
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used, clippy::float_cmp)] // exact values by intent
-    use crate::{
-        assign_causality, BondGraph, Capacitor, EffortSource, Inertia, OneJunction, Resistor,
-        StateEquations,
-    };
     use nalgebra::DMatrix;
 
     /// Every probe of a mass–spring–damper against central differences of `read`.
     #[test]
     fn probe_gradients_match_differences() {
-        let mut g = BondGraph::new();
-        g.add("force", EffortSource::new(3.0)).unwrap();
-        g.add("v", OneJunction).unwrap();
-        g.add("mass", Inertia::new(2.0, 0.0).unwrap()).unwrap();
-        g.add("spring", Capacitor::new(0.02, 0.0).unwrap()).unwrap();
-        g.add("damper", Resistor::new(3.0).unwrap()).unwrap();
-        for (a, b) in [
-            ("force", "v"),
-            ("v", "mass"),
-            ("v", "spring"),
-            ("v", "damper"),
-        ] {
-            g.connect_names(a, b).unwrap();
-        }
-        let eqs = StateEquations::new(assign_causality(g).unwrap()).unwrap();
+        let eqs = crate::test_models::msd(2.0, 0.02, 3.0, 3.0, None);
         let names = eqs.probe_names();
         let probes: Vec<_> = names.iter().map(|n| eqs.probe(n).unwrap()).collect();
         let x = [0.7, -0.3];
