@@ -31,17 +31,18 @@
 //! * **Gravity**: `V_g` of every material point at its shortened position; since Δ adds to
 //!   the position, `ΔV_g = g Σ_i sin φ_i (∫ρA u_i + m_out,i s_i) = −½ g Σ_i sin φ_i qᵀW_i q`
 //!   with `W_i = ∫ρA S + m_out,i S(L)` (`m_out,i` the mass outboard of link i).
-//! * **Kinetic energy**: the term of `½∫ρA|v|²` that is quadratic in the modal coordinates and
-//!   in the link's rotation rate, `½ Ω_i² ∫ρA 2x u = −½ Ω_i² qᵀ D_i q`,
-//!   `D_i = ∫ρA x S(x) dx` (the centrifugal stiffening of a spinning beam, Southwell's term):
-//!   `ΔM_jl = −qᵀD_iq` (joints j, l ≤ i), `ΔE_k = −Ω_i² (D_i q)_k`, and their derivatives.
+//! * **Kinetic energy** ([`kinetic`]): every material point at its shortened position, the
+//!   outboard links on the shifted chord ends, kept to second order in the modal
+//!   coordinates — the link frame's translation against the shortening (`∫ρA u̇`, `∫ρA u`),
+//!   the centrifugal term (`∫ρA x u`, Southwell's) and the outboard links' momenta against
+//!   `ṡ_j`, `s_j φ̇_j`. So the inertial axial forces of the frames' accelerations stiffen or
+//!   soften like gravity does (a link on a base accelerating upward at a bends like the link
+//!   under gravity a). Terms of third and fourth order (`Δv·w`, `|Δv|²`) are dropped, so M
+//!   stays positive definite for deflections small against the links, not for any.
 //!
-//! Point masses on the link count in `∫ρA` (`m S(x₀)`, `m x₀ S(x₀)`). The remaining
-//! kinetic terms of the shortening — the translation of the link's frame against `u̇` and the
-//! motion of the outboard links with the shifted chord ends — are of the same order but carry
-//! only inertial axial forces of the frames' accelerations; they are left out (the model is
-//! still Lagrangian: `T' = ½uᵀM'u` and `V'` are exact derivatives of what is kept, so energy is
-//! conserved and the Jacobian is exact). The reaction block and the projections (eq. 38) use
+//! Point masses on the link count in `∫ρA` (`m S(x₀)`, `m x₀ S(x₀)`). The model stays
+//! Lagrangian: `T' = ½uᵀM'u` and `V'` are exact derivatives of what is kept, so energy is
+//! conserved and the Jacobian is exact. The reaction block and the projections (eq. 38) use
 //! the paper's kinematics.
 //!
 //! # Precomputed, once per link (by Gauss–Legendre quadrature, at least 64 points)
@@ -59,6 +60,8 @@ use crate::kinematics::ArmKinematics;
 use crate::link::Link;
 use crate::mode_shape::ModeShape;
 use crate::quadrature::GaussLegendre;
+
+mod kinetic;
 use bondgraph::ParamError;
 
 /// The integrals of a link's shortening, m × m each.
@@ -167,11 +170,6 @@ impl ShorteningIntegrals {
 /// `(Xq)_k`.
 fn times(x: &DMatrix<f64>, q: &[f64], k: usize) -> f64 {
     q.iter().enumerate().map(|(l, ql)| x[(k, l)] * ql).sum()
-}
-
-/// `qᵀXq`.
-fn quadratic(x: &DMatrix<f64>, q: &[f64]) -> f64 {
-    (0..q.len()).map(|k| q[k] * times(x, q, k)).sum()
 }
 
 impl Pose<'_> {
@@ -284,69 +282,6 @@ impl ArmKinematics<'_> {
                 f(i, arm.modal_offset(i), self.pose.modal(i), omega, sh);
             }
         }
-    }
-
-    /// `ΔT = −½ Σ_i Ω_i² qᵀD_iq`.
-    pub(crate) fn stiffening_kinetic_energy(&self, u: &[f64]) -> f64 {
-        let mut t = 0.0;
-        self.stiffened(Some(u), |_, _, q, om, sh| {
-            t -= 0.5 * om * om * quadratic(sh.moment(), q);
-        });
-        t
-    }
-
-    /// `M += ΔM`: `−qᵀD_iq` on the joints j, l ≤ i of every stiffened link i.
-    pub(crate) fn add_stiffening_mass(&self, m: &mut DMatrix<f64>) {
-        self.stiffened(None, |i, _, q, _, sh| {
-            let c = quadratic(sh.moment(), q);
-            for j in 0..=i {
-                for l in 0..=i {
-                    m[(j, l)] -= c;
-                }
-            }
-        });
-    }
-
-    /// `E += −Ω_i² D_i q` and `Ṁu += −2Ω_i (D_iq)·u^b` on the joints ≤ i.
-    pub(crate) fn add_stiffening_kinetic(
-        &self,
-        u: &[f64],
-        e: &mut [f64],
-        mut mdot_u: Option<&mut [f64]>,
-    ) {
-        self.stiffened(Some(u), |i, o, q, om, sh| {
-            let mut rate = 0.0;
-            for k in 0..q.len() {
-                let dq = times(sh.moment(), q, k);
-                e[o + k] -= om * om * dq;
-                rate += dq * u[o + k];
-            }
-            if let Some(md) = mdot_u.as_deref_mut() {
-                for mj in md.iter_mut().take(i + 1) {
-                    *mj -= 2.0 * om * rate;
-                }
-            }
-        });
-    }
-
-    /// `B[(j, k)] += −2Ω_i (D_iq)_k` (joints j ≤ i, modes k of link i), `H += −Ω_i² D_i`.
-    pub(crate) fn add_stiffening_kinetic_partials(
-        &self,
-        u: &[f64],
-        b: &mut DMatrix<f64>,
-        h: &mut DMatrix<f64>,
-    ) {
-        self.stiffened(Some(u), |i, o, q, om, sh| {
-            for k in 0..q.len() {
-                let dq = times(sh.moment(), q, k);
-                for j in 0..=i {
-                    b[(j, o + k)] -= 2.0 * om * dq;
-                }
-                for l in 0..q.len() {
-                    h[(o + k, o + l)] -= om * om * sh.moment()[(k, l)];
-                }
-            }
-        });
     }
 
     /// `(W_i q)_k` with `W_i = ∫ρA S + m_out,i S(L)`.
