@@ -336,3 +336,48 @@ impl ArmKinematics<'_> {
         });
     }
 }
+
+impl ArmKinematics<'_> {
+    /// `d²/dt² (σ e_j)` in frame 0 for `σ = −½ q_jᵀXq_j` of link j's modes, at speeds u and
+    /// accelerations u̇: `σ̈ e_j + 2σ̇ φ̇_j n_j + σ (φ̈_j n_j − φ̇_j² e_j)` — the acceleration a
+    /// shortening adds to the points it moves (the reaction block's Newton's law).
+    pub(crate) fn shortening_acceleration(
+        &self,
+        j: usize,
+        x: impl Fn(usize, usize) -> f64,
+        u: &[f64],
+        u_dot: &[f64],
+    ) -> Vector2<f64> {
+        let (q, qd) = self.modal(j, u);
+        let (_, qdd) = self.modal(j, u_dot);
+        let (mut s, mut sd, mut sdd) = (0.0, 0.0, 0.0);
+        for a in 0..q.len() {
+            for b in 0..q.len() {
+                let xab = x(a, b);
+                s -= 0.5 * q[a] * xab * q[b];
+                sd -= q[a] * xab * qd[b];
+                sdd -= qd[a] * xab * qd[b] + q[a] * xab * qdd[b];
+            }
+        }
+        let (rate, accel): (f64, f64) = (u[..=j].iter().sum(), u_dot[..=j].iter().sum());
+        let (c, sn) = self.pose.cos_sin(j);
+        let (e, n) = (Vector2::new(c, sn), Vector2::new(-sn, c));
+        (sdd - s * rate * rate) * e + (2.0 * sd * rate + s * accel) * n
+    }
+
+    /// The acceleration (frame 0) the shortened chords j < i add to every point of link i.
+    pub(crate) fn chord_shortening_acceleration(
+        &self,
+        i: usize,
+        u: &[f64],
+        u_dot: &[f64],
+    ) -> Vector2<f64> {
+        let arm = self.arm();
+        (0..i)
+            .filter_map(|j| {
+                let c = arm.shape_integrals(j).shortening()?.chord();
+                Some(self.shortening_acceleration(j, |a, b| c[(a, b)], u, u_dot))
+            })
+            .sum()
+    }
+}

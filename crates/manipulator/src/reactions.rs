@@ -20,6 +20,11 @@
 //! ∫ρA a = (m V̇_x − Ω̇ ∫ρA w, m V̇_y + Ω̇ s₁ + ∫ρA ẅ) + (m A_x − Ω ∫ρA ẇ, m A_y) + Ω ẑ × p.
 //! ```
 //!
+//! With geometric stiffening every point also moves with the shortening of its own link
+//! and of the chords inboard of it, `Σ_{k<i} s_k e_k + u(x) e_i`
+//! ([`geometric_stiffening`](crate::geometric_stiffening)), whose acceleration
+//! `d²/dt²(σ e) = σ̈ e + 2σ̇ φ̇ n + σ(φ̈ n − φ̇² e)` adds to `∫ρA a` (with `∫ρA u = −½qᵀ(∫ρA S)q`).
+//!
 //! `ρ_{2j−1}, ρ_{2j}` is the force that the inboard body exerts on link j through joint j,
 //! in the axes of frame j (x along link j's chord; for the pendulum from the pivot to the
 //! payload). A pendulum at rest gives `ρ = (−m g, 0)`. Internal forces — strain, modal
@@ -120,10 +125,27 @@ impl ArmKinematics<'_> {
                 mass * fd.v.y + fd.omega * s1 + w_ddot,
             ) + Vector2::new(mass * f.a.x - om * d.w_dot, mass * f.a.y)
                 + om * z_cross(&p);
-            add(i, self.pose.to_base(i, &ma) + mass * weight, rho);
+            let mut ma = self.pose.to_base(i, &ma);
+            if arm.has_geometric_stiffening() {
+                // the shortening of the inboard chords and of the link itself
+                ma += mass * self.chord_shortening_acceleration(i, u, u_dot);
+                if let Some(sh) = g.shortening() {
+                    let x = sh.mass();
+                    ma += self.shortening_acceleration(i, |a, b| x[(a, b)], u, u_dot);
+                }
+            }
+            add(i, ma + mass * weight, rho);
         }
         for (s, m) in rigid_masses {
-            let a = self.point_acceleration(s, u, u_dot);
+            let mut a = self.point_acceleration(s, u, u_dot);
+            if arm.has_geometric_stiffening() {
+                a += self.chord_shortening_acceleration(s.link, u, u_dot);
+                if !s.shortening.is_empty() {
+                    let n = s.psi.len();
+                    let x = |a: usize, b: usize| s.shortening[a * n + b];
+                    a += self.shortening_acceleration(s.link, x, u, u_dot);
+                }
+            }
             add(s.link, *m * (a + weight), rho);
         }
         for (s, f) in loads {

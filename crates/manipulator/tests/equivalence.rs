@@ -69,7 +69,11 @@ fn frequency(t: &[f64], y: &[f64]) -> f64 {
 /// Runs the scene (with a torque on joint 1 if `torque` is given) and returns the first
 /// bending frequency of the last link and φ̇₁ at the end.
 fn vibrate(scene: ArmScene, torque: Option<f64>) -> (f64, f64) {
-    let n = scene.links.iter().map(|l| 1 + l.modes().len()).sum::<usize>();
+    let n = scene
+        .links
+        .iter()
+        .map(|l| 1 + l.modes().len())
+        .sum::<usize>();
     let links = scene.links.len();
     let mut g = BondGraph::new();
     let ports = scene.add_to(&mut g, "arm").unwrap();

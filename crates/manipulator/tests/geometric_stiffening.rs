@@ -327,7 +327,67 @@ fn the_kinetic_energy_is_the_exact_one_to_second_order_in_the_deflection() {
         }
         // the relative error falls with ε (∝ ε: a third-order rest); a missing or wrong
         // second-order term would leave it constant
-        assert!(errs[1] < errs[0] / 1.6 && errs[2] < errs[1] / 1.6, "{errs:?}");
+        assert!(
+            errs[1] < errs[0] / 1.6 && errs[2] < errs[1] / 1.6,
+            "{errs:?}"
+        );
         assert!(errs[2] < 1e-4, "{errs:?}");
+    }
+}
+
+#[test]
+fn the_reactions_are_newtons_law_of_the_shortened_points() {
+    // ρ at joint j is the force that accelerates everything outboard of it against gravity:
+    // R_0^j Σ ∫ρA (r̈ + g ŷ) over the links ≥ j, with r̈ by central differences in time of the
+    // points' shortened positions along q(t) = q + u t + ½u̇t². No loads, no rigid masses.
+    let (plain, stiff) = arms();
+    let mut rng = Rng::new(53);
+    let rule = bg_manipulator::GaussLegendre::new(48).unwrap();
+    for _ in 0..3 {
+        let q = rng.q(&stiff, 0.05);
+        let (u, u_dot) = (rng.vec(stiff.n(), 1.0), rng.vec(stiff.n(), 1.0));
+        let newton = |arm: &PlanarArm| {
+            let h = 1e-3;
+            let at = |t: f64| -> Vec<f64> {
+                (0..q.len())
+                    .map(|k| q[k] + u[k] * t + 0.5 * u_dot[k] * t * t)
+                    .collect()
+            };
+            let qs = [at(-2.0 * h), at(-h), at(0.0), at(h), at(2.0 * h)];
+            let poses: Vec<_> = qs.iter().map(|q| arm.pose(q)).collect();
+            let mut per_link = vec![Vector2::zeros(); arm.n_links()];
+            for (i, link) in arm.links().iter().enumerate() {
+                let mut point = |x: f64, m: f64| {
+                    let s = arm.station(i, x).unwrap();
+                    let r: Vec<Vector2<f64>> = poses.iter().map(|p| p.position(&s)).collect();
+                    let a =
+                        (-r[0] + 16.0 * r[1] - 30.0 * r[2] + 16.0 * r[3] - r[4]) / (12.0 * h * h);
+                    per_link[i] += m * (a + Vector2::new(0.0, G));
+                };
+                if link.mass_per_length() > 0.0 {
+                    for (x, w) in rule.on(link.length()) {
+                        point(x, w * link.mass_per_length());
+                    }
+                }
+                for pm in link.point_masses() {
+                    point(pm.x, pm.mass);
+                }
+            }
+            let mut rho = DVector::zeros(2 * arm.n_links());
+            for j in 0..arm.n_links() {
+                let f: Vector2<f64> = per_link[j..].iter().sum();
+                let fj = poses[2].to_frame(j, &f);
+                rho[2 * j] = fj.x;
+                rho[2 * j + 1] = fj.y;
+            }
+            rho
+        };
+        let model = |arm: &PlanarArm| arm.kinematics(&q).reactions(&u, &u_dot, &[], &[]);
+        let (got, want) = (
+            model(&stiff) - model(&plain),
+            newton(&stiff) - newton(&plain),
+        );
+        let col = |v: DVector<f64>| DMatrix::from_column_slice(v.len(), 1, v.as_slice());
+        assert_change("Δρ", &col(got), &col(want));
     }
 }

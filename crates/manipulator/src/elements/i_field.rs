@@ -16,7 +16,8 @@
 //!
 //! Publishes `u` (n), `udot` (n; `u̇ = M⁻¹(ṗ − Ṁu)`, computed in a second stage from the
 //! effort received), `T` (kinetic energy), and per link i (1-based): `x_e{i}`, `y_e{i}`, the
-//! end of its chord in frame 0 (for hinged–hinged modes the deformed end), and `w{i}_mid`,
+//! end of its chord in frame 0 (for hinged–hinged modes the deformed end; with geometric
+//! stiffening moved by the shortening of its own and the inboard chords), and `w{i}_mid`,
 //! the deflection at mid-chord. Its states are `p[k]` and `q[k]`; the vector `<name>.q` is
 //! what the other fields read. Each coordinate is also published by name, with its speed:
 //! `q1`, `u1`, … for the joints and `qb{i}_{k}`, `ub{i}_{k}` for the modes of link i
@@ -61,6 +62,9 @@ pub struct ArmInertia {
     p0: Vec<f64>,
     p_nominal: Vec<f64>,
     mid: Vec<Option<Station>>,
+    /// With geometric stiffening, the chord end of each link as a station (x = L), which
+    /// moves with the shortening of its own and the inboard chords; empty without.
+    ends: Vec<Station>,
     /// (coordinate name, speed name, index in q or `None` for an unmodelled mode).
     named: Vec<(String, String, Option<usize>)>,
     ws: RefCell<Motion>,
@@ -298,6 +302,13 @@ impl ArmInertia {
                     .flatten()
             })
             .collect();
+        let ends = if arm.has_geometric_stiffening() {
+            (0..arm.n_links())
+                .map(|i| arm.station(i, arm.links()[i].length()))
+                .collect::<Result<_, _>>()?
+        } else {
+            Vec::new()
+        };
         let mut named: Vec<(String, String, Option<usize>)> = (1..=arm.n_links())
             .map(|i| (format!("q{i}"), format!("u{i}"), Some(i - 1)))
             .collect();
@@ -319,6 +330,7 @@ impl ArmInertia {
             p0,
             p_nominal,
             mid,
+            ends,
             named,
         })
     }
@@ -431,7 +443,10 @@ impl Element for ArmInertia {
                 io.set_y(OUT_T, 0, state.kinetic);
                 let pose = self.arm.pose_in(&x[n..], frames);
                 for i in 0..self.arm.n_links() {
-                    let end = pose.origin(i + 1);
+                    let end = self
+                        .ends
+                        .get(i)
+                        .map_or_else(|| pose.origin(i + 1), |s| pose.position(s));
                     let w = self.mid[i].as_ref().map_or(0.0, |s| pose.deflection(s));
                     io.set_y(OUT_LINKS + 3 * i, 0, end.x);
                     io.set_y(OUT_LINKS + 3 * i + 1, 0, end.y);
@@ -493,15 +508,23 @@ impl Element for ArmInertia {
                 }
                 let pose = self.arm.pose_in(&x[n..], frames);
                 for i in 0..self.arm.n_links() {
-                    let end = pose.origin(i + 1);
                     let (rx, ry) = (
                         jac.row(Slot::Output(OUT_LINKS + 3 * i), 0),
                         jac.row(Slot::Output(OUT_LINKS + 3 * i + 1), 0),
                     );
-                    for j in 0..=i {
-                        let d = z_cross(&(end - pose.origin(j)));
-                        jac.set(rx, jac.state_col(n + j), d.x);
-                        jac.set(ry, jac.state_col(n + j), d.y);
+                    if let Some(s) = self.ends.get(i) {
+                        // the shortened chord end: its columns, shortening included
+                        pose.point_jacobian(s, |k, d| {
+                            jac.set(rx, jac.state_col(n + k), d.x);
+                            jac.set(ry, jac.state_col(n + k), d.y);
+                        });
+                    } else {
+                        let end = pose.origin(i + 1);
+                        for j in 0..=i {
+                            let d = z_cross(&(end - pose.origin(j)));
+                            jac.set(rx, jac.state_col(n + j), d.x);
+                            jac.set(ry, jac.state_col(n + j), d.y);
+                        }
                     }
                     if let Some(s) = &self.mid[i] {
                         let rw = jac.row(Slot::Output(OUT_LINKS + 3 * i + 2), 0);
