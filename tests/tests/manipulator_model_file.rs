@@ -170,3 +170,100 @@ fn mistakes_in_nested_tables_are_reported_with_their_path() {
         assert!(e.line.is_some(), "{msg}");
     }
 }
+
+/// A free two-link arm whose first link is given by `link1` (a TOML inline table's inside).
+fn two_links(link1: &str) -> String {
+    format!(
+        r#"
+[parameters]
+E = 210e9
+rho = 7850.0
+A = 0.0264
+I = 5.89e-4
+
+[tables]
+boom_EI = {{ x = [0, 10], y = [1.9e8, 0.76e8] }}
+boom_rhoA = {{ x = [0, 10], y = [260, 104] }}
+
+[elements.arm]
+kind = "manipulator.planar_arm"
+q0 = [0.3, -1.0, 0.02, -0.01, 0.005, 0.01, 0.0, -0.003]
+u0 = [0.2, -0.4, 0.3, 0.1, -0.2, 0.05, 0.1, 0.2]
+geometric_stiffening = true
+links = [
+  {{ type = "beam", length = 10.0, modes = 3, {link1} }},
+  {{ type = "beam", length = 8.0, E = "E", rho = "rho", A = "A", I = "I", modes = 3 }},
+]
+
+[simulation]
+t_end = 0.1
+"#
+    )
+}
+
+/// The right-hand side at the initial state.
+fn rhs(link1: &str) -> Vec<f64> {
+    let model = Model::from_text("arm.toml", &two_links(link1), &registry(), &[])
+        .unwrap_or_else(|e| panic!("{link1}: {e} {:?}", e.hint));
+    let eqs = &model.equations;
+    let x = eqs.initial_state();
+    let mut dx = vec![0.0; x.len()];
+    eqs.rhs(0.0, &x, &mut dx);
+    dx
+}
+
+fn assert_same(what: &str, a: &[f64], b: &[f64], tol: f64) {
+    let scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let err = a
+        .iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    eprintln!("{what}: max |Δ| / max |ẋ| = {:.1e}", err / scale);
+    assert!(err <= tol * scale, "{what}: {err:e} of {scale:e}");
+}
+
+#[test]
+fn link_profiles_may_be_expressions_or_tables_of_x() {
+    let uniform = rhs(r#"E = "E", rho = "rho", A = "A", I = "I""#);
+    // a uniform link given as expressions (constant, or reading x) equals the uniform link
+    let base = r#"E = "E", rho = "rho", A = "A", I = "I""#;
+    for given in [
+        r#"EI_of_x = "E*I", rhoA_of_x = "rho*A", rhoI_of_x = "rho*I""#,
+        r#"EI_of_x = "E*I*(1 + 0*x)", rhoA_of_x = "rho*A + 0*x", rhoI_of_x = "rho*I + x - x""#,
+    ] {
+        let other = rhs(&format!("{base}, {given}"));
+        assert_same(given, &other, &uniform, 1e-12);
+    }
+    // a linear taper: by samples, by an expression of x, by tables called at x
+    let samples = rhs(&format!(
+        "{base}, EI_samples = [1.9e8, 1.33e8, 0.76e8], rhoA_samples = [260, 182, 104]"
+    ));
+    let expression = rhs(&format!(
+        r#"{base}, EI_of_x = "1.9e8*(1 - 0.06*x)", rhoA_of_x = "260*(1 - 0.06*x)""#
+    ));
+    let tables = rhs(&format!(
+        r#"{base}, EI_of_x = "boom_EI(x)", rhoA_of_x = "boom_rhoA(x)""#
+    ));
+    assert_same("taper by expression", &expression, &samples, 1e-12);
+    assert_same("taper by tables", &tables, &samples, 1e-12);
+    let diff = uniform
+        .iter()
+        .zip(&samples)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(diff > 1e-3, "the taper changes the dynamics");
+    // mistakes: another variable than x, or samples and an expression at once
+    for (given, expect) in [
+        (r#"EI_of_x = "2e8*s""#, "is an expression of `x`"),
+        (r#"EI_of_x = "2e8*(1 + arm_arm.q1*x)""#, "may read only x"),
+        (r#"EI_of_x = "2e8", EI_samples = [2e8, 1e8]"#, "not both"),
+    ] {
+        let text = two_links(&format!("{base}, {given}"));
+        let e = Model::from_text("arm.toml", &text, &registry(), &[])
+            .err()
+            .unwrap();
+        let msg = format!("{e} {}", e.hint.clone().unwrap_or_default());
+        assert!(msg.contains(expect), "expected `{expect}` in: {msg}");
+        assert!(msg.contains("links[1]"), "{msg}");
+        assert!(e.line.is_some(), "{msg}");
+    }
+}

@@ -33,7 +33,7 @@
 //! arm uses (damping) rebuild its members. Every key is declared in [`PLANAR_ARM`]'s tables.
 
 use bondgraph::kind::{BuildError, KindDecl, ParamDecl, Params, Range};
-use bondgraph::{Composite, ParamError};
+use bondgraph::{Composite, Param, ParamError};
 
 use crate::actuator::LinearActuator;
 use crate::link::{Link, PointMass, Profile};
@@ -108,7 +108,32 @@ const LINK: &[ParamDecl] = &[
         "ρI(x) sampled likewise (beam; replaces rho·I)",
     )
     .optional("uniform"),
+    ParamDecl::modulated(
+        "EI_of_x",
+        "N·m²",
+        "EI as an expression of x, the distance from the joint (m), or a table called at x, \
+         \"boom_EI(x)\"; sampled at 4097 equally spaced x when built (beam; replaces E·I)",
+    )
+    .of("x")
+    .optional("uniform"),
+    ParamDecl::modulated(
+        "rhoA_of_x",
+        "kg/m",
+        "ρA as an expression of x likewise (beam; replaces rho·A)",
+    )
+    .of("x")
+    .optional("uniform"),
+    ParamDecl::modulated(
+        "rhoI_of_x",
+        "kg·m",
+        "ρI as an expression of x likewise (beam; replaces rho·I)",
+    )
+    .of("x")
+    .optional("uniform"),
 ];
+
+/// Samples of a profile given as an expression of x (equally spaced from 0 to L).
+const PROFILE_SAMPLES: usize = 4097;
 
 const PIN: &[ParamDecl] = &[
     ParamDecl::vector("ground", "m", "a pin on the ground at [x, y]").optional("a pin on a link"),
@@ -191,6 +216,9 @@ fn link(k: usize, t: &dyn Params) -> Result<Link, BuildError> {
                     "EI_samples",
                     "rhoA_samples",
                     "rhoI_samples",
+                    "EI_of_x",
+                    "rhoA_of_x",
+                    "rhoI_of_x",
                 ],
                 "rigid",
             )?;
@@ -215,6 +243,9 @@ fn link(k: usize, t: &dyn Params) -> Result<Link, BuildError> {
                     "EI_samples",
                     "rhoA_samples",
                     "rhoI_samples",
+                    "EI_of_x",
+                    "rhoA_of_x",
+                    "rhoI_of_x",
                 ],
                 "pendulum",
             )?;
@@ -233,17 +264,27 @@ fn link(k: usize, t: &dyn Params) -> Result<Link, BuildError> {
                 t.number("I")?,
             )
             .map_err(fail())?;
-            let samples = |key: &str| -> Result<Option<Vec<f64>>, BuildError> {
-                if t.has(key) {
-                    Ok(Some(t.vector(key)?))
-                } else {
-                    Ok(None)
+            let samples = |key: &str, of_x: &str| -> Result<Option<Vec<f64>>, BuildError> {
+                match (t.has(key), t.has(of_x)) {
+                    (true, true) => Err(BuildError::conflict(
+                        of_x,
+                        format!("links[{}]: give `{key}` or `{of_x}`, not both", k + 1),
+                    )
+                    .within(&format!("links[{}]", k + 1))),
+                    (true, false) => Ok(Some(t.vector(key)?)),
+                    (false, true) => {
+                        let at = format!("links[{}]", k + 1);
+                        profile_of_x(&t.modulated(of_x)?, of_x, &at, length)
+                            .map(Some)
+                            .map_err(|e| e.within(&at))
+                    }
+                    (false, false) => Ok(None),
                 }
             };
             let profile = Profile {
-                bending_stiffness: samples("EI_samples")?,
-                mass_per_length: samples("rhoA_samples")?,
-                rotary_inertia_per_length: samples("rhoI_samples")?,
+                bending_stiffness: samples("EI_samples", "EI_of_x")?,
+                mass_per_length: samples("rhoA_samples", "rhoA_of_x")?,
+                rotary_inertia_per_length: samples("rhoI_samples", "rhoI_of_x")?,
             };
             let beam = if profile == Profile::default() {
                 beam
@@ -263,6 +304,37 @@ fn link(k: usize, t: &dyn Params) -> Result<Link, BuildError> {
         l = l.with_point_mass(mass).map_err(fail())?;
     }
     Ok(l)
+}
+
+/// A profile given as an expression of x (or a table called at x), sampled at
+/// [`PROFILE_SAMPLES`] equally spaced points from 0 to `length` (linear between: exact for a
+/// linear profile; for a curved one off by at most `(L/4096)² max|f''|/8`).
+fn profile_of_x(p: &Param, key: &str, at: &str, length: f64) -> Result<Vec<f64>, BuildError> {
+    let x_at = |k: usize| length * k as f64 / (PROFILE_SAMPLES - 1) as f64;
+    match p {
+        Param::Const(c) => Ok(vec![*c; 2]),
+        Param::Modulated { inputs, law, .. } => {
+            if let Some(other) = inputs.iter().find(|n| n.as_str() != "x") {
+                return Err(BuildError::invalid(
+                    key,
+                    format!(
+                        "`{at}.{key}` may read only x (the distance from the joint, m), not `{other}`"
+                    ),
+                )
+                .hint(
+                    "a table is called at x, e.g. \"boom_EI(x)\"; parameters of [parameters] \
+                     may appear",
+                ));
+            }
+            let mut at = vec![0.0; inputs.len()];
+            Ok((0..PROFILE_SAMPLES)
+                .map(|k| {
+                    at.fill(x_at(k));
+                    law(0.0, &at)
+                })
+                .collect())
+        }
+    }
 }
 
 fn pin(t: &dyn Params, at: &str) -> Result<Pin, BuildError> {

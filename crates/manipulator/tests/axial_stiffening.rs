@@ -213,7 +213,10 @@ fn a_spinning_cantilever_stiffens_as_the_rotating_beam_equation_says() {
         let want = ritz(om, 9).0;
         // the reference is converged: 9 against 10 polynomial functions
         let finer = ritz(om, 10).0;
-        assert!((want / finer - 1.0).abs() < 1e-8, "Ritz not converged at {ratio}");
+        assert!(
+            (want / finer - 1.0).abs() < 1e-8,
+            "Ritz not converged at {ratio}"
+        );
         let southwell = (omega0 * omega0 + (k_flap - 1.0) * om * om).sqrt();
         assert!(
             (rayleigh(om) / southwell - 1.0).abs() < 1e-6,
@@ -228,7 +231,10 @@ fn a_spinning_cantilever_stiffens_as_the_rotating_beam_equation_says() {
         );
         worst = worst.max(err.abs());
         // an upper bound, as a one-term Ritz estimate must be
-        assert!(one_mode > -1e-9, "Southwell below the converged value at {ratio}");
+        assert!(
+            one_mode > -1e-9,
+            "Southwell below the converged value at {ratio}"
+        );
         if ratio <= 1.0 {
             southwell_to_w0 = southwell_to_w0.max(one_mode);
         } else {
@@ -239,5 +245,8 @@ fn a_spinning_cantilever_stiffens_as_the_rotating_beam_equation_says() {
     assert!(worst < 2e-4, "model vs converged Ritz: {worst:e}");
     // the one-mode formula's own error: measured 0.55 % at Ω = ω₀, 4.85 % at Ω = 2ω₀
     assert!(southwell_to_w0 < 6e-3, "{southwell_to_w0:e}");
-    assert!((0.047..0.050).contains(&southwell_at_2), "{southwell_at_2:e}");
+    assert!(
+        (0.047..0.050).contains(&southwell_at_2),
+        "{southwell_at_2:e}"
+    );
 }

@@ -315,8 +315,14 @@ impl<'a> ElementSpec<'a> {
         self.params.get(key).map(|r| &r.value)
     }
 
-    /// Compile an expression: model parameters become constants, other names signal inputs.
-    fn compile(&self, key: &str, e: &Expr) -> Result<(Compiled, Vec<String>), BuildError> {
+    /// Compile an expression: model parameters become constants, other names signal inputs
+    /// (and the declared `variable` of a function, e.g. `x` along a link, an input too).
+    fn compile(
+        &self,
+        key: &str,
+        e: &Expr,
+        variable: Option<&str>,
+    ) -> Result<(Compiled, Vec<String>), BuildError> {
         let mut inputs = Vec::new();
         for n in e.names() {
             if n == "pi" {
@@ -324,14 +330,19 @@ impl<'a> ElementSpec<'a> {
             }
             if self.constants.contains_key(&n) {
                 self.used_constants.borrow_mut().insert(n);
-            } else if n == "t" || n == "time" || n.contains('.') || self.inputs.contains(&n) {
+            } else if n == "t"
+                || n == "time"
+                || n.contains('.')
+                || self.inputs.contains(&n)
+                || variable == Some(n.as_str())
+            {
                 if !inputs.contains(&n) {
                     inputs.push(n);
                 }
             } else {
                 return Err(self
                     .err(BuildErrorKind::Invalid, key, format!("`{key}` uses `{n}`, which is neither a parameter nor a signal"))
-                    .hint(format!("define `{n}` in [parameters] or [inputs], or name a signal as `<element>.<variable>`; parameters: {}", clip(&self.constants.keys().cloned().collect::<Vec<_>>().join(", ")))));
+                    .hint(format!("{}define `{n}` in [parameters] or [inputs], or name a signal as `<element>.<variable>`; parameters: {}", variable.map(|v| format!("`{key}` is an expression of `{v}`; ")).unwrap_or_default(), clip(&self.constants.keys().cloned().collect::<Vec<_>>().join(", ")))));
             }
         }
         let max = bondgraph::element::MAX_PARAM_INPUTS;

@@ -232,6 +232,10 @@ pub struct ParamDecl {
     pub range: Range,
     /// One line of description.
     pub doc: &'static str,
+    /// A modulated value that is a function of this variable (e.g. `x` along a link),
+    /// which its expression may name besides parameters and signals; the builder evaluates
+    /// it. `None`: parameters and signals only.
+    pub variable: Option<&'static str>,
 }
 
 impl ParamDecl {
@@ -243,6 +247,7 @@ impl ParamDecl {
             default: Default::Required,
             range: Range::ANY,
             doc,
+            variable: None,
         }
     }
     /// A required constant number.
@@ -318,6 +323,12 @@ impl ParamDecl {
     #[must_use]
     pub const fn optional(self, meaning: &'static str) -> Self {
         self.with_default(Default::Optional(meaning))
+    }
+    /// A function of `variable`, which its expression may name ([`ParamDecl::variable`]).
+    #[must_use]
+    pub const fn of(mut self, variable: &'static str) -> Self {
+        self.variable = Some(variable);
+        self
     }
     /// With this [`Default`].
     #[must_use]

@@ -44,7 +44,7 @@ impl Params for ElementSpec<'_> {
                 .ok_or_else(|| self.missing(d));
         };
         let e = self.expr(d, v)?;
-        let (compiled, inputs) = self.compile(key, &e)?;
+        let (compiled, inputs) = self.compile(key, &e, d.variable)?;
         if let Some(c) = compiled.constant() {
             return self.in_range(d, c).map(Param::Const);
         }
