@@ -106,6 +106,13 @@ impl ShorteningIntegrals {
     /// The integrals of `link` with `max(points, 64)` Gauss–Legendre points.
     pub fn of(link: &Link, points: usize) -> Result<Self, ParamError> {
         let m = link.modes().len();
+        if m > kinetic::MAX_MODES {
+            return Err(ParamError::invalid(
+                "modes",
+                m as f64,
+                "at most 64 modes per link with geometric stiffening",
+            ));
+        }
         let l = link.length();
         let rho_a = link.mass_per_length();
         let mut out = Self {

@@ -67,20 +67,45 @@ fn turns(r: usize, c: usize, d: usize) -> f64 {
     f64::from(u8::from(r <= c)) - f64::from(u8::from(r <= d))
 }
 
-/// What a term needs at (q, u): f, f′, f″, the quadratic forms and the link's modes.
-struct At<'q> {
+/// Modes per link the kinetic terms of the shortening handle (their products are kept on
+/// the stack); [`ShorteningIntegrals::of`](super::ShorteningIntegrals::of) refuses more.
+pub(crate) const MAX_MODES: usize = 64;
+
+/// What a term needs at (q, u): f, f′, f″ of its angle, and `Xq`, `Xq̇`, `Q = −½qᵀXq`,
+/// `B = −qᵀXq̇`, `q̇ᵀXq̇` of its link's modes — kept while consecutive terms share X.
+struct At<'s> {
     f: [f64; 3],
-    q: &'q [f64],
-    ub: &'q [f64],
     o: usize,
-    /// `Q = −½qᵀXq`, `B = −qᵀXq̇`.
+    m: usize,
+    x: Option<&'s DMatrix<f64>>,
+    link: usize,
+    xq: [f64; MAX_MODES],
+    xu: [f64; MAX_MODES],
     quad: f64,
     bil: f64,
+    uxu: f64,
 }
 
-impl ArmKinematics<'_> {
+impl At<'_> {
+    fn new() -> Self {
+        Self {
+            f: [0.0; 3],
+            o: 0,
+            m: 0,
+            x: None,
+            link: usize::MAX,
+            xq: [0.0; MAX_MODES],
+            xu: [0.0; MAX_MODES],
+            quad: 0.0,
+            bil: 0.0,
+            uxu: 0.0,
+        }
+    }
+}
+
+impl<'a> ArmKinematics<'a> {
     /// Calls `visit` for every term of ΔT (module docs).
-    fn shortening_terms_of_t(&self, mut visit: impl FnMut(&Term<'_>)) {
+    fn shortening_terms_of_t(&self, mut visit: impl FnMut(&Term<'a>)) {
         let arm = self.arm();
         let length = |k: usize| arm.links()[k].length();
         for i in 0..arm.n_links() {
@@ -123,44 +148,49 @@ impl ArmKinematics<'_> {
         }
     }
 
-    /// A term at the current q and speeds u (`u` empty: at q only, `B` zero).
-    fn term_at<'q>(&'q self, t: &Term<'_>, u: &'q [f64]) -> At<'q> {
+    /// `at` for the term `t` at the current q and speeds u (`u` empty: at q only, `B` zero);
+    /// the products with X are recomputed only when X or the link changes.
+    fn term_at<'s>(&self, at: &mut At<'s>, t: &Term<'s>, u: &[f64]) {
         let (cc, sc) = self.pose.cos_sin(t.c);
         let (cd, sd) = self.pose.cos_sin(t.d);
         let (cos, sin) = (cc * cd + sc * sd, sc * cd - cc * sd);
-        let f = if t.sine {
+        at.f = if t.sine {
             [sin, cos, -sin]
         } else {
             [cos, -sin, -cos]
         };
-        let (q, ub) = if u.is_empty() {
-            (self.pose.modal(t.link), u)
-        } else {
-            self.modal(t.link, u)
-        };
-        let (mut quad, mut bil) = (0.0, 0.0);
-        for k in 0..q.len() {
-            let xq = times(t.x, q, k);
-            quad -= 0.5 * q[k] * xq;
-            if let Some(uk) = ub.get(k) {
-                bil -= xq * uk;
-            }
+        if at.link == t.link && at.x.is_some_and(|x| std::ptr::eq(x, t.x)) {
+            return;
         }
-        At {
-            f,
-            q,
-            ub,
-            o: self.arm().modal_offset(t.link),
-            quad,
-            bil,
+        let q = self.pose.modal(t.link);
+        let ub = if u.is_empty() {
+            u
+        } else {
+            self.modal(t.link, u).1
+        };
+        let m = q.len();
+        (at.x, at.link, at.m, at.o) = (Some(t.x), t.link, m, self.arm().modal_offset(t.link));
+        (at.quad, at.bil, at.uxu) = (0.0, 0.0, 0.0);
+        for k in 0..m {
+            let (xq, xu) = (
+                times(t.x, q, k),
+                ub.get(k).map_or(0.0, |_| times(t.x, ub, k)),
+            );
+            at.xq[k] = xq;
+            at.xu[k] = xu;
+            at.quad -= 0.5 * q[k] * xq;
+            if let Some(uk) = ub.get(k) {
+                at.bil -= xq * uk;
+                at.uxu += xu * uk;
+            }
         }
     }
 
     /// `ΔT` at speeds u.
     pub(crate) fn stiffening_kinetic_energy(&self, u: &[f64]) -> f64 {
-        let mut sum = 0.0;
+        let (mut sum, mut at) = (0.0, At::new());
         self.shortening_terms_of_t(|t| {
-            let at = self.term_at(t, u);
+            self.term_at(&mut at, t, u);
             sum += t.kappa
                 * at.f[0]
                 * match t.b {
@@ -173,8 +203,9 @@ impl ArmKinematics<'_> {
 
     /// `M += ΔM`.
     pub(crate) fn add_stiffening_mass(&self, m: &mut DMatrix<f64>) {
+        let mut at = At::new();
         self.shortening_terms_of_t(|t| {
-            let at = self.term_at(t, &[]);
+            self.term_at(&mut at, t, &[]);
             let kf = t.kappa * at.f[0];
             match t.b {
                 // T = κ f Q φ̇_a φ̇_b: M_rs += κ f Q ([r≤a][s≤b] + [r≤b][s≤a])
@@ -188,8 +219,8 @@ impl ArmKinematics<'_> {
                 }
                 // T = κ f φ̇_a (−Xq)·q̇: M_{s,k} = M_{k,s} += κ f (−Xq)_k, s ≤ a
                 None => {
-                    for k in 0..at.q.len() {
-                        let v = -kf * times(t.x, at.q, k);
+                    for k in 0..at.m {
+                        let v = -kf * at.xq[k];
                         for s in 0..=t.a {
                             m[(s, at.o + k)] += v;
                             m[(at.o + k, s)] += v;
@@ -207,8 +238,9 @@ impl ArmKinematics<'_> {
         e: &mut [f64],
         mut mdot_u: Option<&mut [f64]>,
     ) {
+        let mut at = At::new();
         self.shortening_terms_of_t(|t| {
-            let at = self.term_at(t, u);
+            self.term_at(&mut at, t, u);
             let (kf, kf1) = (t.kappa * at.f[0], t.kappa * at.f[1]);
             let phi_a = rate(u, t.a);
             // Δ̇ = φ̇_c − φ̇_d
@@ -217,8 +249,8 @@ impl ArmKinematics<'_> {
                 Some(b) => {
                     let phi_b = rate(u, b);
                     let ab = phi_a * phi_b;
-                    for k in 0..at.q.len() {
-                        e[at.o + k] -= kf * ab * times(t.x, at.q, k);
+                    for k in 0..at.m {
+                        e[at.o + k] -= kf * ab * at.xq[k];
                     }
                     for (r, er) in e.iter_mut().enumerate().take(t.c.max(t.d) + 1) {
                         *er += kf1 * ab * at.quad * turns(r, t.c, t.d);
@@ -235,26 +267,21 @@ impl ArmKinematics<'_> {
                     }
                 }
                 None => {
-                    for k in 0..at.q.len() {
-                        e[at.o + k] -= kf * phi_a * times(t.x, at.ub, k);
+                    for k in 0..at.m {
+                        e[at.o + k] -= kf * phi_a * at.xu[k];
                     }
                     for (r, er) in e.iter_mut().enumerate().take(t.c.max(t.d) + 1) {
                         *er += kf1 * phi_a * at.bil * turns(r, t.c, t.d);
                     }
                     if let Some(md) = mdot_u.as_deref_mut() {
                         // joints s ≤ a: κ (f (−Xq̇)·q̇ + f′ B Δ̇)
-                        let xuu: f64 = (0..at.q.len())
-                            .map(|k| times(t.x, at.ub, k) * at.ub[k])
-                            .sum();
-                        let c = -kf * xuu + kf1 * at.bil * turn_rate;
+                        let c = -kf * at.uxu + kf1 * at.bil * turn_rate;
                         for ms in md.iter_mut().take(t.a + 1) {
                             *ms += c;
                         }
                         // modes: κ φ̇_a (f (−Xq̇)_k + f′ (−Xq)_k Δ̇)
-                        for k in 0..at.q.len() {
-                            md[at.o + k] -= phi_a
-                                * (kf * times(t.x, at.ub, k)
-                                    + kf1 * times(t.x, at.q, k) * turn_rate);
+                        for k in 0..at.m {
+                            md[at.o + k] -= phi_a * (kf * at.xu[k] + kf1 * at.xq[k] * turn_rate);
                         }
                     }
                 }
@@ -269,18 +296,19 @@ impl ArmKinematics<'_> {
         bm: &mut DMatrix<f64>,
         h: &mut DMatrix<f64>,
     ) {
+        let mut at = At::new();
         self.shortening_terms_of_t(|t| {
-            let at = self.term_at(t, u);
+            self.term_at(&mut at, t, u);
             let [kf, kf1, kf2] = at.f.map(|f| t.kappa * f);
             let phi_a = rate(u, t.a);
-            let (m, o) = (at.q.len(), at.o);
+            let (m, o) = (at.m, at.o);
             let joints = t.c.max(t.d) + 1;
             match t.b {
                 Some(b) => {
                     let phi_b = rate(u, b);
                     let ab = phi_a * phi_b;
                     for k in 0..m {
-                        let xq = times(t.x, at.q, k);
+                        let xq = at.xq[k];
                         for l in 0..m {
                             h[(o + k, o + l)] -= kf * ab * t.x[(k, l)];
                         }
@@ -303,7 +331,7 @@ impl ArmKinematics<'_> {
                     for s in 0..=t.a.max(b) {
                         let ws = w(s);
                         for k in 0..m {
-                            bm[(s, o + k)] -= kf * ws * times(t.x, at.q, k);
+                            bm[(s, o + k)] -= kf * ws * at.xq[k];
                         }
                         for r in 0..joints {
                             bm[(s, r)] += kf1 * at.quad * ws * turns(r, t.c, t.d);
@@ -312,7 +340,7 @@ impl ArmKinematics<'_> {
                 }
                 None => {
                     for k in 0..m {
-                        let xu = times(t.x, at.ub, k);
+                        let xu = at.xu[k];
                         for r in 0..joints {
                             let v = -kf1 * phi_a * xu * turns(r, t.c, t.d);
                             h[(o + k, r)] += v;
@@ -327,14 +355,14 @@ impl ArmKinematics<'_> {
                     }
                     for s in 0..=t.a {
                         for k in 0..m {
-                            bm[(s, o + k)] -= kf * times(t.x, at.ub, k);
+                            bm[(s, o + k)] -= kf * at.xu[k];
                         }
                         for r in 0..joints {
                             bm[(s, r)] += kf1 * at.bil * turns(r, t.c, t.d);
                         }
                     }
                     for s in 0..m {
-                        let xq = times(t.x, at.q, s);
+                        let xq = at.xq[s];
                         for k in 0..m {
                             bm[(o + s, o + k)] -= kf * phi_a * t.x[(s, k)];
                         }
