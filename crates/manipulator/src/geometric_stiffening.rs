@@ -85,7 +85,12 @@ pub(crate) fn slope_products(modes: &[std::sync::Arc<dyn ModeShape>], x: f64) ->
     if x <= 0.0 {
         return s;
     }
-    let Ok(rule) = GaussLegendre::new(POINTS) else {
+    // the 64-point rule, computed once per process (stations are made at build time, often)
+    static RULE: std::sync::OnceLock<Option<GaussLegendre>> = std::sync::OnceLock::new();
+    let Some(rule) = RULE
+        .get_or_init(|| GaussLegendre::new(POINTS).ok())
+        .as_ref()
+    else {
         return s;
     };
     let mut slope = vec![0.0; m];
