@@ -17,6 +17,12 @@ pub fn push_f64(out: &mut Vec<u8>, v: f64) {
     }
     let mut buf = zmij::Buffer::new();
     let s = buf.format_finite(v).as_bytes();
+    if !s.contains(&b'e') {
+        // plain decimal notation, and not an integer (those are short exact values): the
+        // same text as `{}`
+        out.extend_from_slice(s);
+        return;
+    }
     let (neg, s) = match s.split_first() {
         Some((b'-', rest)) => (true, rest),
         _ => (false, s),
