@@ -9,7 +9,7 @@ pub fn push_f64(out: &mut Vec<u8>, v: f64) {
     if !v.is_finite() || v == 0.0 || short_exact(v) {
         // NaN, ±inf, ±0, and values whose exact decimal expansion is short (where two
         // shortest candidates can tie and the two writers break the tie differently:
-        // -167581363823776.125 is `…776.13` by `{}`, `…776.12` by zmij): the standard
+        // -1.6758136382377612…e14 is `…776.13` by `{}`, `…776.12` by zmij): the standard
         // writer is the definition
         use std::io::Write;
         let _ = write!(out, "{v}");
@@ -160,7 +160,7 @@ mod tests {
             std::f64::consts::PI,
             1.0 / 3.0,
             9_007_199_254_740_993.0,
-            -167_581_363_823_776.125,
+            f64::from_bits(0xc2e3_0d42_752c_9404), // -167581363823776.12…, a tie
             0.5,
             2.25,
             1e-3,
