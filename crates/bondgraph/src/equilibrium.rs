@@ -377,6 +377,30 @@ fn merit(s: &[f64]) -> f64 {
 /// time `t`, starting from `x0` (which also gives every other state).
 ///
 /// # Returns
+/// Most states a steady solve takes: each Newton iteration assembles the dense n×n Jacobian
+/// (8·n² bytes: 128 MB at 4 000 states).
+pub const MAX_STEADY_STATES: usize = 4000;
+
+/// Most unknowns a steady solve takes: each Newton iteration factors the m×m reduced Jacobian
+/// by SVD (about 10·m³ operations: a second or so at 500 unknowns).
+pub const MAX_STEADY_UNKNOWNS: usize = 500;
+
+/// Why a steady solve of `n` states and `m` unknowns is refused before any work, if it is.
+#[must_use]
+pub fn steady_size_error(n: usize, m: usize) -> Option<String> {
+    if n > MAX_STEADY_STATES {
+        Some(format!(
+            "{n} states, more than the {MAX_STEADY_STATES} a steady solve takes: it is dense (an n×n Jacobian of 8·n² bytes per Newton iteration)"
+        ))
+    } else if m > MAX_STEADY_UNKNOWNS {
+        Some(format!(
+            "{m} unknowns, more than the {MAX_STEADY_UNKNOWNS} a steady solve takes: it is dense (an SVD of the m×m reduced Jacobian, about 10·m³ operations, per Newton iteration)"
+        ))
+    } else {
+        None
+    }
+}
+
 /// The state vector with the unknowns solved and the residual of each condition, or an
 /// [`EquilibriumError`] naming the unknowns and the largest residuals.
 ///
@@ -396,6 +420,9 @@ pub fn solve_steady(
             "the state vector has {} values, the equations {n} states",
             x0.len()
         )));
+    }
+    if let Some(m) = steady_size_error(n, req.unknowns.len()) {
+        return Err(EquilibriumError::Invalid(m));
     }
     for (k, &u) in req.unknowns.iter().enumerate() {
         if u >= n {

@@ -104,15 +104,15 @@ pub use element::{
 pub use elements::*;
 pub use equations::{LengthMismatch, Probe, StateEquations, StateInfo};
 pub use equilibrium::{
-    solve_steady, Condition, Equilibrium, EquilibriumError, Settle, SteadyRequest,
-    OWN_SCALE_FRACTION,
+    solve_steady, steady_size_error, Condition, Equilibrium, EquilibriumError, Settle,
+    SteadyRequest, MAX_STEADY_STATES, MAX_STEADY_UNKNOWNS, OWN_SCALE_FRACTION,
 };
 pub use error::{CausalityError, Error, GraphError, ParamError, SimulationError};
 pub use graph::{BondGraph, Node};
 pub use kind::{BuildError, Composite, KindDecl, ParamDecl, Params};
 pub use linearize::{linearize, BodePoint, Linearization};
 pub use local_jacobian::{LocalJacobian, LocalShape};
-pub use modes::{modes, modes_of, stiffness_ratio, Mode, ModesError};
+pub use modes::{modes, modes_of, stiffness_ratio, Mode, ModesError, MAX_MODES_STATES};
 /// The dense matrix type of [`StateEquations::jacobian`].
 pub use nalgebra::DMatrix;
 pub use partials_check::check_partials;

@@ -67,6 +67,36 @@ pub fn apply(file: &str, text: &str, overrides: &[String]) -> Result<String, Mod
     Ok(doc.to_string())
 }
 
+/// Whether `apply` would accept the one override `o` on the parsed file `doc`, without
+/// writing the file out again: the override is tried on a copy of the one section it
+/// names (what `set_path` reads is that section alone), so checking many overrides
+/// (every choice of every `[scene]` switch) parses the file once.
+pub(crate) fn check(file: &str, doc: &DocumentMut, o: &str) -> Result<(), ModelError> {
+    let err =
+        |m: String| ModelError::new(ErrorKind::Override, file, format!("--set {}: {m}", clip(o)));
+    let (key, value) = o
+        .split_once('=')
+        .ok_or_else(|| err("expected key=value".into()))?;
+    let path = split_key(key.trim()).map_err(err)?;
+    let value = parse_value(value.trim());
+    let mut root = toml_edit::Table::new();
+    if let Some(first) = path.first() {
+        // `events[0]` reads the section `events`; a key written `name[k]` is itself a key
+        for k in [first.key.clone(), first.literal()] {
+            if let Some(item) = doc.as_table().get(&k) {
+                root.insert(&k, item.clone());
+            }
+        }
+    }
+    set_path(&mut Item::Table(root), &path, 0, value).map_err(|(m, hint)| {
+        let e = err(m);
+        match hint {
+            Some(h) => e.hint(h),
+            None => e,
+        }
+    })
+}
+
 /// One segment of a `--set` key: a key, with an array index if written `name[k]`.
 #[derive(Clone, Debug, PartialEq)]
 struct Segment {
@@ -333,6 +363,41 @@ mod tests {
             out.lines().position(|l| l.starts_with("mass")),
             MODEL.lines().position(|l| l.starts_with("mass"))
         );
+    }
+
+    #[test]
+    fn check_agrees_with_apply_on_every_kind_of_key() {
+        let model = format!(
+            "{MODEL}\n[initial]\n\"arm.q[1]\" = 0.5\n\n[[events]]\nt = 0.5\nset = {{ k = 1.0 }}\n\n[[check]]\nvalue = \"k\"\nexpected = 1\ntol = 1\n"
+        );
+        let doc: DocumentMut = model.parse().unwrap();
+        for o in [
+            "parameters.k=5",
+            "parameters.kk=5",
+            "elements.mass.m=2",
+            "elements.spring.c=1",
+            "elements.mass=3",
+            "simulation.solver=bdf",
+            "simulation.tend=1",
+            "nosection.x=1",
+            "events[0].t=0.2",
+            "events[3].t=0.2",
+            "events.t=0.2",
+            "events[0].set.k=2",
+            "check[0].tol=2",
+            "initial.\"arm.q[1]\"=0.1",
+            "initial.x=1",
+            "nokey",
+            "parameters..k=1",
+        ] {
+            let a = apply("m.toml", &model, &[o.to_owned()]).map(drop);
+            let c = check("m.toml", &doc, o);
+            assert_eq!(
+                a.as_ref().map_err(ToString::to_string),
+                c.as_ref().map_err(ToString::to_string),
+                "{o}"
+            );
+        }
     }
 
     #[test]

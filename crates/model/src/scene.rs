@@ -129,6 +129,14 @@ pub(crate) fn read(
         ));
     }
     let mut switches = Vec::new();
+    // parsed once for the checks of every choice's overrides below
+    let doc: toml_edit::DocumentMut = match text.parse() {
+        Ok(d) => d,
+        Err(e) => {
+            let e: toml_edit::TomlError = e;
+            return Err(err(None, e.message().to_owned()));
+        }
+    };
     for (name, v) in table {
         let span = name.span();
         let fail = |m: String, hint: &str| {
@@ -277,7 +285,7 @@ pub(crate) fn read(
         // every override of every choice must be one that `--set` accepts on this file
         for k in 0..switch.choices.len() {
             for o in switch.overrides(k) {
-                if let Err(e) = crate::overrides::apply(file, text, std::slice::from_ref(&o)) {
+                if let Err(e) = crate::overrides::check(file, &doc, &o) {
                     let why = e.message.clone();
                     let hint = e.hint.clone().unwrap_or_else(|| {
                         "`set` and `also` take the keys of `--set`: parameters.NAME, elements.NAME.OPTION, …".into()

@@ -304,6 +304,12 @@ pub(crate) fn solve(
     for u in &spec.unknowns {
         unknowns.extend(expand(eqs, u)?);
     }
+    if let Some(m) = bondgraph::steady_size_error(eqs.n_states(), unknowns.len()) {
+        return Err((
+            format!("[initial.steady] `{}`: {m}", spec.name),
+            Some("give the start in [initial] instead (e.g. the end of a settling run: `bg-sim run` with its t_end, then the last row), or solve a smaller variant of the model (fewer segments of a line) and take its values".into()),
+        ));
+    }
     let mut conds = Vec::new();
     for c in &spec.conditions {
         conds.extend(conditions(eqs, c, parameters)?);

@@ -40,6 +40,19 @@ fn modes(path: &Path, at: Option<f64>, set: &[String], json: bool, top: usize) -
             return ExitCode::from(BAD_INPUT);
         }
     };
+    // Before any work (the run to --at included): the analysis is dense.
+    let n = model.equations.n_states();
+    if n > bondgraph::MAX_MODES_STATES {
+        tell!(
+            "error: {}: {}\n  hint: analyse a smaller variant of the model (fewer segments of a line, fewer modes per link: --set, or the cheaper scenes of `bg-sim reduce`); `bg-sim linearize` writes A for an eigen-solver of its own",
+            model.file(),
+            bondgraph::ModesError::TooLarge {
+                n,
+                limit: bondgraph::MAX_MODES_STATES
+            }
+        );
+        return ExitCode::from(BAD_INPUT);
+    }
     if let Some(t) = at {
         if !(t.is_finite() && t >= model.settings.t_start) {
             tell!(

@@ -1,6 +1,7 @@
 //! `bg-sim run`: simulate a model and stream its results to CSV ([`output`]), then draw the
 //! model's figures if `--plots` asks for them.
 
+mod number;
 mod output;
 
 use std::path::{Path, PathBuf};

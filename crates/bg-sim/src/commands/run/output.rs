@@ -184,8 +184,8 @@ impl RowSink for CsvSink {
                 self.buf.push(b',');
             }
             first = false;
-            // infallible: writing to a Vec
-            let _ = write!(self.buf, "{v}");
+            // as `{v}` writes it, faster (number.rs)
+            super::number::push_f64(&mut self.buf, *v);
         }
         self.buf.push(b'\n');
         self.buffered.push(row.first().copied().unwrap_or(f64::NAN));
