@@ -221,6 +221,10 @@ impl Element for Line {
     fn kind(&self) -> &str {
         "hydraulics.line"
     }
+    fn energy_role(&self, _: usize) -> bondgraph::EnergyRole {
+        // The segments' C and I store, their R (Hagen–Poiseuille) dissipates inside.
+        bondgraph::EnergyRole::LossyStorage
+    }
     fn ports(&self) -> Ports {
         Ports::Fixed(vec![PortSpec::new("a", 1), PortSpec::new("b", 1)])
     }
