@@ -54,6 +54,31 @@ pub struct ElementActivity {
 /// and every element's activity.
 pub type Audit<'a> = dyn Fn(&mut Model) -> Result<(Outcome, Vec<ElementActivity>), String> + 'a;
 
+/// The energy audit ([`bg_model::Model::run_energy`], `bg-sim energy`) as the [`Audit`] of
+/// the reduction: the run's rows kept, every element's activity and share, labelled with its
+/// entry of the model file.
+///
+/// # Errors
+/// The model cannot be run.
+pub fn energy_audit(m: &mut Model) -> Result<(Outcome, Vec<ElementActivity>), String> {
+    let mut rows: Vec<Vec<f64>> = Vec::new();
+    let run = m.run_energy(&mut rows).map_err(|e| e.to_string())?;
+    let mut outcome = run.outcome;
+    outcome.trajectory.rows = rows;
+    let ranking = run
+        .report
+        .elements
+        .into_iter()
+        .map(|e| ElementActivity {
+            name: e.name,
+            composite: e.composite,
+            activity: e.activity,
+            share: e.share,
+        })
+        .collect();
+    Ok((outcome, ranking))
+}
+
 /// One proposed simplification of one entry of the model file.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Candidate {
@@ -493,6 +518,18 @@ pub fn reduce_by_activity(
     let text = bg_model::overrides::apply(&file, &text, &o.set).map_err(|e| e.to_string())?;
     let mut full = Model::from_text(&file, &text, registry, &[]).map_err(|e| e.to_string())?;
     configure(&mut full, o)?;
+    if let Some(cols) = &o.columns {
+        let have: Vec<&str> = full.outputs.iter().map(|c| c.name.as_str()).collect();
+        if let Some(c) = cols
+            .iter()
+            .find(|c| c.as_str() != "t" && !have.contains(&c.as_str()))
+        {
+            return Err(format!(
+                "{file} has no output column `{c}`\n  hint: its columns are {}",
+                have.join(", ")
+            ));
+        }
+    }
     let states = full.equations.n_states();
     let (out, mut ranking) = audit(&mut full)?;
     if let Some(e) = &out.error {
