@@ -21,6 +21,9 @@
 //!
 //! The simplifications are applied to the model file's text ([`apply`]): the reducer knows
 //! the changes (set a key, remove one, set a key in every entry of a list), never the kind.
+//! With `--columns`, every run (the full model's too) keeps only the scored outputs and no
+//! `[[check]]` ([`keep_only`]): an output reading a variable that a simplification removes
+//! would otherwise stop the reduced model from loading.
 
 use std::path::Path;
 use std::time::Duration;
@@ -421,6 +424,33 @@ pub fn apply(text: &str, picks: &[&Candidate]) -> Result<String, String> {
     Ok(doc.to_string())
 }
 
+/// The model file `text` with only the output columns `columns` (and `t`), and without its
+/// `[[check]]`s and `[[plot]]`s: what the reducer runs when the user names the columns to
+/// score, so that an output or a check reading a variable a simplification removes (a
+/// line's `p[2]`) does not stop the reduced model from loading. The full model is run the
+/// same way, so that their times compare.
+///
+/// # Errors
+/// The text is not TOML.
+pub fn keep_only(text: &str, columns: &[String]) -> Result<String, String> {
+    let mut doc: DocumentMut = text
+        .parse()
+        .map_err(|e: toml_edit::TomlError| e.to_string())?;
+    if let Some(outputs) = doc.get_mut("outputs").and_then(Item::as_table_like_mut) {
+        let drop: Vec<String> = outputs
+            .iter()
+            .map(|(k, _)| k.to_owned())
+            .filter(|k| !columns.contains(k))
+            .collect();
+        for k in drop {
+            outputs.remove(&k);
+        }
+    }
+    doc.remove("check");
+    doc.remove("plot");
+    Ok(doc.to_string())
+}
+
 /// Set the options' end time, solver and tolerance on a loaded model.
 pub(crate) fn configure(m: &mut Model, o: &ReduceOptions) -> Result<(), String> {
     if let Some(t) = o.t_end {
@@ -515,7 +545,7 @@ pub fn reduce_by_activity(
     }
     let file = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read {file}: {e}"))?;
-    let text = bg_model::overrides::apply(&file, &text, &o.set).map_err(|e| e.to_string())?;
+    let mut text = bg_model::overrides::apply(&file, &text, &o.set).map_err(|e| e.to_string())?;
     let mut full = Model::from_text(&file, &text, registry, &[]).map_err(|e| e.to_string())?;
     configure(&mut full, o)?;
     if let Some(cols) = &o.columns {
@@ -529,6 +559,11 @@ pub fn reduce_by_activity(
                 have.join(", ")
             ));
         }
+    }
+    if let Some(cols) = &o.columns {
+        text = keep_only(&text, cols)?;
+        full = Model::from_text(&file, &text, registry, &[]).map_err(|e| e.to_string())?;
+        configure(&mut full, o)?;
     }
     let states = full.equations.n_states();
     let (out, mut ranking) = audit(&mut full)?;
