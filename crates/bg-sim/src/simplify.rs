@@ -294,7 +294,7 @@ fn equals_default(kind: &KindDecl, key: &str, value: &str) -> bool {
         Default::Value(x) => v
             .as_float()
             .or_else(|| v.as_integer().map(|i| i as f64))
-            .is_some_and(|y| y == x),
+            .is_some_and(|y| y.total_cmp(&x).is_eq()), // the number written, not computed
         Default::Word(w) => v.as_str() == Some(w),
         Default::Flag(b) => v.as_bool() == Some(b),
         _ => false,

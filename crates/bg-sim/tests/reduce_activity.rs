@@ -191,7 +191,8 @@ fn the_lift_circuit_reduced_by_activity_stays_within_tol() {
 #[test]
 fn every_declared_simplification_loads_and_runs() {
     // (kind, simplification, model, --set, element, end time)
-    let cases: &[(&str, &str, &str, &[&str], &str, f64)] = &[
+    type Case<'a> = (&'a str, &'a str, &'a str, &'a [&'a str], &'a str, f64);
+    let cases: &[Case] = &[
         (
             "hydraulics.relief_valve",
             "no_seat_leak",
