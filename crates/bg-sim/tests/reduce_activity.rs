@@ -291,6 +291,11 @@ fn every_declared_simplification_loads_and_runs() {
                 k.name,
                 s.name
             );
+            let text = bg_sim::kinds::report(&reg, k.name).unwrap();
+            assert!(
+                text.contains(&format!("  {} — {}", s.name, s.doc)),
+                "{text}"
+            );
             for ch in s.changes {
                 let key = ch.key().split("[*].").next().unwrap_or("");
                 assert!(
