@@ -321,7 +321,7 @@ fn by_activity(
         r.threshold
     );
     say!("| element | entry | activity (J) | share |\n|---|---|---|---|");
-    for e in r.ranking.iter().filter(|e| e.activity > 0.0) {
+    for e in r.ranking.iter().filter(|e| e.share > 0.0) {
         say!(
             "| {} | {} | {:.3e} | {:.2e} |",
             e.name,
