@@ -51,6 +51,24 @@ pub fn report(registry: &Registry, name: &str) -> Result<String, ModelError> {
     }
     let _ = writeln!(out, "\nparameters:\n{}", parameter_table(&r.decl));
     let _ = writeln!(out, "example: {{ {} }}", r.decl.example);
+    if !r.decl.simplifications.is_empty() {
+        let _ = writeln!(out, "\nsimplifications (`bg-sim reduce --by activity`):");
+        for s in r.decl.simplifications {
+            let changes: Vec<String> = s.changes.iter().map(ToString::to_string).collect();
+            let _ = writeln!(
+                out,
+                "  {} — {} ({}{})",
+                s.name,
+                s.doc,
+                changes.join(", "),
+                if s.members.is_empty() {
+                    String::new()
+                } else {
+                    format!("; the activity of {}", s.members.join(", "))
+                }
+            );
+        }
+    }
     let composite = !r.exposed.is_empty();
     if composite {
         let _ = writeln!(

@@ -13,7 +13,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use commands::{
-    bench, check, compare, graph, kinds, linearize, modes, plot, reduce, run, sweep, FAILED,
+    bench, check, compare, energy, graph, kinds, linearize, modes, plot, reduce, run, sweep, FAILED,
 };
 
 #[derive(Parser)]
@@ -57,6 +57,10 @@ enum Command {
     /// Measure the speed–accuracy trade: every solver at every rtol against a reference
     /// (wall time, steps, rhs evaluations, the worst scaled error of the scored columns).
     Bench(bench::Args),
+    /// Where the energy goes: run a model with its energy audit and list, per composite (or
+    /// element, --expand), the energy supplied, stored, dissipated and its activity ∫|P| dt,
+    /// the balance and the efficiency; --plot draws it (docs/energy.md).
+    Energy(energy::Args),
     /// Find the cheapest scene of the model's `[scene]` switches whose scaled error against
     /// the richest scene stays within --tol on the named columns.
     Reduce(reduce::Args),
@@ -78,6 +82,7 @@ fn main() -> ExitCode {
             | Command::Compare { .. }
             | Command::Modes { .. }
             | Command::Linearize { .. }
+            | Command::Energy { .. }
     );
     let code = dispatch(cli.command);
     let lost = report::STDOUT_ERROR.lock().ok().and_then(|e| *e);
@@ -106,6 +111,7 @@ fn dispatch(command: Command) -> ExitCode {
         Command::Modes(a) => modes::command(&a),
         Command::Linearize(a) => linearize::command(&a),
         Command::Bench(a) => bench::command(a),
+        Command::Energy(a) => energy::command(&a),
         Command::Reduce(a) => reduce::command(a),
         Command::Compare(a) => compare::command(&a),
         Command::Plot(a) => plot::command(&a),

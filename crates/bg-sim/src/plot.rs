@@ -11,6 +11,7 @@
 
 mod bode;
 mod contour;
+mod energy;
 mod figure;
 mod quick;
 mod results;
@@ -24,6 +25,7 @@ use plotters::style::register_font;
 
 pub use bode::bode;
 pub use contour::{contour, Map};
+pub use energy::{energy_bars, energy_segments, Segment};
 pub use figure::{draw, draw_all};
 pub use quick::quick_look;
 pub use results::Results;

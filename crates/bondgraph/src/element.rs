@@ -279,10 +279,21 @@ pub trait Element: Debug {
         Vec::new()
     }
 
-    /// Energy stored at states `x` (for energy-balance tests), if the element stores any.
+    /// Energy stored at states `x` (this element's states), if the element stores any and
+    /// it is a function of its own states: the energy audit's `stored` is then
+    /// E(end) − E(start) ([`crate::energy`]), else the integral of its port power.
     fn stored_energy(&self, x: &[f64]) -> Option<f64> {
         let _ = x;
         None
+    }
+
+    /// What the element does with the power that enters it, for the energy audit
+    /// ([`crate::energy`]): by default what its causal rule says
+    /// ([`EnergyRole::from_rule`](crate::energy::EnergyRole::from_rule)); elements whose rule
+    /// does not tell (a modulated flow source with two ports, a lossy machine, a field whose
+    /// effort comes from another element's states) say it here.
+    fn energy_role(&self, n_ports: usize) -> crate::energy::EnergyRole {
+        crate::energy::EnergyRole::from_rule(&self.causal_rule(n_ports))
     }
 
     /// The external input this element is, if it is one ([`Input`](crate::Input): its signal

@@ -56,6 +56,11 @@
 //! [`StateEquations::new`] orders every element's stages into an evaluation plan computing
 //! dx/dt = f(t, x) and every effort, flow and signal, and refuses algebraic loops.
 //!
+//! ## Energy
+//! [`energy`] audits a run ([`simulate_audited`] with an [`EnergyAudit`]): per element the
+//! energy supplied, stored, dissipated and its activity ∫|P| dt, by each element's
+//! [`EnergyRole`], integrated on the dense output after every accepted step.
+//!
 //! ## Steady states and modes
 //! [`solve_steady`] solves chosen unknown states for as many conditions (state derivatives or
 //! states held at values) by Newton's method with the exact Jacobian ([`equilibrium`]).
@@ -78,6 +83,7 @@ pub mod bond;
 pub mod causality;
 pub mod element;
 pub mod elements;
+pub mod energy;
 pub mod equations;
 pub mod equilibrium;
 pub mod error;
@@ -102,6 +108,7 @@ pub use element::{
     Watch,
 };
 pub use elements::*;
+pub use energy::{ElementEnergy, EnergyAudit, EnergyReport, EnergyRole};
 pub use equations::{LengthMismatch, Probe, StateEquations, StateInfo};
 pub use equilibrium::{
     solve_steady, steady_size_error, Condition, Equilibrium, EquilibriumError, Settle,
@@ -118,7 +125,7 @@ pub use nalgebra::DMatrix;
 pub use partials_check::check_partials;
 pub use radau::{OdeSystem, Radau5, RadauError, RadauOptions, RadauStats, StepReport};
 pub use simulate::{
-    check_in_memory, simulate, simulate_into, Event, Method, Outcome, Output, RowSink, Settings,
-    Simulation, Statistics, Trajectory, WatchReport, MAX_OUTPUT_ROWS, MAX_VALUES_IN_MEMORY,
-    MIN_RTOL,
+    check_in_memory, simulate, simulate_audited, simulate_into, Event, Method, Outcome, Output,
+    RowSink, Settings, Simulation, Statistics, Trajectory, WatchReport, MAX_OUTPUT_ROWS,
+    MAX_VALUES_IN_MEMORY, MIN_RTOL,
 };

@@ -27,7 +27,7 @@ use crate::orifice;
 use bondgraph::kind::{BuildError, KindDecl, ParamDecl, Params};
 use bondgraph::ParamError;
 
-use crate::pressure_valve::{Opening, PressureValve, G_LEAK, SMOOTHING};
+use crate::pressure_valve::{Opening, PressureValve, G_LEAK, NO_SEAT_LEAK, SMOOTHING};
 
 /// Parameters of a counterbalance valve; [`CounterbalanceValve::build`] makes the element.
 #[derive(Clone, Debug, PartialEq)]
@@ -134,6 +134,7 @@ pub const KIND: KindDecl = KindDecl::element(
     ],
     build,
 )
+.simplifications(&[NO_SEAT_LEAK])
 .example("alpha = 6e-7, p_set = 1.1e7");
 
 fn build(p: &dyn Params) -> Result<Box<dyn bondgraph::Element>, BuildError> {

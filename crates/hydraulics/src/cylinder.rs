@@ -20,7 +20,9 @@
 //! Chamber pressures start from [`InitialPressures`]; [`hold_pressures`] is the scene's
 //! static initialisation rule.
 
-use bondgraph::kind::{member_name, BuildError, KindDecl, ParamDecl, Params};
+use bondgraph::kind::{
+    member_name, BuildError, Change, KindDecl, ParamDecl, Params, Simplification,
+};
 use bondgraph::{BondGraph, Composite, Error, OneJunction, Param, ParamError, ZeroJunction};
 
 use crate::{fluid, orifice};
@@ -401,6 +403,30 @@ pub const KIND: KindDecl = KindDecl::composite(
     ],
     build,
 )
+.simplifications(&[
+    Simplification::new(
+        "no_internal_leakage",
+        "piston seal tight: no r_int",
+        &[Change::Unset("r_int")],
+    )
+    .members(&["leak"]),
+    Simplification::new(
+        "no_external_leakage",
+        "rod and chamber seals tight: no r_ext",
+        &[Change::Unset("r_ext")],
+    )
+    .members(&["leak_p", "leak_r"]),
+    Simplification::new(
+        "no_end_stop",
+        "no end stop (leaving the stroke stops the run)",
+        &[
+            Change::Unset("k_stop"),
+            Change::Unset("c_stop"),
+            Change::Unset("stop_width"),
+        ],
+    )
+    .members(&["end_stop"]),
+])
 .example(
     "a_p = 0.0045, a_r = 0.0025, l_p0 = 0.05, l_r0 = 0.55, s_max = 0.5, beta = 1.5e9, s0 = 0.1",
 );

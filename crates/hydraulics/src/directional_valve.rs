@@ -38,7 +38,7 @@
 //! Causality: every port receives its pressure and sets its flow (conductance): attach each to
 //! a 0-junction with a chamber (a hose volume) or to a pressure source.
 
-use bondgraph::kind::{BuildError, KindDecl, ParamDecl, Range};
+use bondgraph::kind::{BuildError, Change, KindDecl, ParamDecl, Range, Simplification};
 use bondgraph::{
     CausalRule, Element, Io, LocalJacobian, Param, ParamError, PortCausality, PortSpec, Ports,
     SignalSpec, Slot, Stage,
@@ -375,6 +375,11 @@ pub const KIND: KindDecl = KindDecl::element(
         Ok(Box::new(v))
     },
 )
+.simplifications(&[Simplification::new(
+    "no_edge_leak",
+    "metering edges tight when closed: g_leak = 0",
+    &[Change::Set("g_leak", "0")],
+)])
 .example("alpha = 6e-7, x_v = \"0.5*sin(t)\", centre = \"open\"");
 
 #[cfg(test)]

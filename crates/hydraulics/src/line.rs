@@ -38,7 +38,7 @@
 //! between two chambers has its `a` end at the upstream element that sets flow; turn it round
 //! (swap `a` and `b` in the bonds) if the causality is the other way.
 
-use bondgraph::kind::{BuildError, KindDecl, ParamDecl, Params, Range};
+use bondgraph::kind::{BuildError, Change, KindDecl, ParamDecl, Params, Range, Simplification};
 use bondgraph::{
     CausalRule, Element, Io, LocalJacobian, ParamError, PortCausality, PortSpec, Ports, Slot,
     Stage, StateSpec,
@@ -221,6 +221,10 @@ impl Element for Line {
     fn kind(&self) -> &str {
         "hydraulics.line"
     }
+    fn energy_role(&self, _: usize) -> bondgraph::EnergyRole {
+        // The segments' C and I store, their R (Hagen–Poiseuille) dissipates inside.
+        bondgraph::EnergyRole::LossyStorage
+    }
     fn ports(&self) -> Ports {
         Ports::Fixed(vec![PortSpec::new("a", 1), PortSpec::new("b", 1)])
     }
@@ -337,6 +341,11 @@ pub const KIND: KindDecl = KindDecl::element(
     ],
     build,
 )
+.simplifications(&[Simplification::new(
+    "one_segment",
+    "one lumped C–R–I segment: the line's volume, loss and inertance, no wave",
+    &[Change::Set("segments", "1")],
+)])
 .example("length = 5.0, diameter = 0.01, beta = 1.5e9, segments = 4");
 
 fn build(p: &dyn Params) -> Result<Box<dyn Element>, BuildError> {

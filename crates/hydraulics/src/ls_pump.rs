@@ -210,6 +210,15 @@ impl Element for LsPump {
     fn kind(&self) -> &str {
         "hydraulics.ls_pump"
     }
+    fn energy_role(&self, _: usize) -> bondgraph::EnergyRole {
+        // With a shaft the machine is a transformer whose net power in is its losses
+        // (leakage, friction); without one it is driven from outside: a source.
+        if self.has_shaft() {
+            bondgraph::EnergyRole::Dissipation
+        } else {
+            bondgraph::EnergyRole::Source
+        }
+    }
     fn ports(&self) -> Ports {
         let mut p = vec![
             PortSpec::new("a", 1),

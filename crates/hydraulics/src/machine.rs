@@ -216,6 +216,15 @@ impl Element for Machine {
             Role::Motor => "hydraulics.motor",
         }
     }
+    fn energy_role(&self, _: usize) -> bondgraph::EnergyRole {
+        // With a shaft the machine is a transformer whose net power in is its losses
+        // (leakage, friction); without one it is driven from outside: a source.
+        if self.has_shaft() {
+            bondgraph::EnergyRole::Dissipation
+        } else {
+            bondgraph::EnergyRole::Source
+        }
+    }
     fn ports(&self) -> Ports {
         let mut p = vec![PortSpec::new("a", 1), PortSpec::new("b", 1)];
         if self.has_shaft() {

@@ -30,7 +30,7 @@
 //! [`Orifice`](crate::Orifice). Publishes each opening xᵢ (`x`, and for two openings the second
 //! one's name, e.g. `x_check`).
 
-use bondgraph::kind::{ParamDecl, Range};
+use bondgraph::kind::{Change, ParamDecl, Range, Simplification};
 use bondgraph::{
     CausalRule, Element, Io, LocalJacobian, ParamError, PortCausality, PortSpec, Ports, SignalSpec,
     Slot, Stage, StateSpec,
@@ -73,6 +73,12 @@ pub const SMOOTHING: ParamDecl = ParamDecl::number(
 )
 .range(Range::closed(0.0, 0.5))
 .default(0.05);
+/// Simplification of a pressure valve: its closed seat shut tight (`g_leak = 0`).
+pub const NO_SEAT_LEAK: Simplification = Simplification::new(
+    "no_seat_leak",
+    "closed seat tight: g_leak = 0",
+    &[Change::Set("g_leak", "0")],
+);
 /// The seat's leak (every pressure valve of this crate declares these two).
 pub const G_LEAK: ParamDecl =
     ParamDecl::number("g_leak", "m³/(s·Pa)", "leak conductance of the closed seat")

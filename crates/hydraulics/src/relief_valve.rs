@@ -30,10 +30,10 @@
 //! opening `x`.
 
 use crate::orifice;
-use bondgraph::kind::{BuildError, KindDecl, ParamDecl, Params};
+use bondgraph::kind::{BuildError, Change, KindDecl, ParamDecl, Params, Simplification};
 use bondgraph::ParamError;
 
-use crate::pressure_valve::{Opening, PressureValve, G_LEAK, SMOOTHING};
+use crate::pressure_valve::{Opening, PressureValve, G_LEAK, NO_SEAT_LEAK, SMOOTHING};
 
 /// Parameters of a relief valve; [`ReliefValve::build`] makes the element.
 #[derive(Clone, Debug, PartialEq)]
@@ -113,6 +113,10 @@ pub const KIND: KindDecl = KindDecl::element(
     ],
     build,
 )
+.simplifications(&[
+    NO_SEAT_LEAK,
+    Simplification::new("static_poppet", "no poppet lag: x at its static opening", &[Change::Unset("tau")]),
+])
 .example("alpha = 2e-7, p_crack = 1.6e7");
 
 fn build(p: &dyn Params) -> Result<Box<dyn bondgraph::Element>, BuildError> {

@@ -120,6 +120,11 @@ impl Element for Valve {
     fn kind(&self) -> &str {
         "hydraulics.valve"
     }
+    fn energy_role(&self, _: usize) -> bondgraph::EnergyRole {
+        // Two modulated flow sources fed from the supply pressure P_s (eqs. 29–30): the
+        // energy they deliver comes from outside the graph.
+        bondgraph::EnergyRole::Source
+    }
     fn ports(&self) -> Ports {
         Ports::Fixed(vec![PortSpec::new("A", 1), PortSpec::new("B", 1)])
     }

@@ -32,7 +32,7 @@
 //! numbers may be expressions of the model's parameters; events that change a parameter the
 //! arm uses (damping) rebuild its members. Every key is declared in [`PLANAR_ARM`]'s tables.
 
-use bondgraph::kind::{BuildError, KindDecl, ParamDecl, Params, Range};
+use bondgraph::kind::{BuildError, Change, KindDecl, ParamDecl, Params, Range, Simplification};
 use bondgraph::{Composite, Param, ParamError};
 
 use crate::actuator::LinearActuator;
@@ -179,6 +179,14 @@ pub const PLANAR_ARM: KindDecl = KindDecl::composite(
     ],
     build_planar_arm,
 )
+.simplifications(&[
+    Simplification::new("rigid_lumped_masses", "lumped masses moving rigidly with their pins (no pin springs)", &[Change::Set("lumped_model", "\"rigid\"")])
+        .members(&["spring", "damper"]),
+    Simplification::new("no_lumped_masses", "lumped masses left out", &[Change::Set("lumped_model", "\"none\"")])
+        .members(&["spring", "damper", "masses", "gravity"]),
+    Simplification::new("rigid_links", "every beam rigid (0 modes)", &[Change::Set("links[*].modes", "0")])
+        .members(&["c", "r"]),
+])
 .example("links = [{ type = \"beam\", length = 1.0, E = 2e11, rho = 7800, A = 1e-3, I = 1e-6, modes = 1 }], q0 = [0.1]");
 
 fn build_planar_arm(p: &dyn Params) -> Result<Composite, BuildError> {

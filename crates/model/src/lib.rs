@@ -70,8 +70,8 @@ pub use data::DataFile;
 pub use describe::{describe, parameter_table, KindReport};
 pub use error::{ErrorKind, ModelError};
 pub use load::{
-    inspect, solver, structure, Check, CheckResult, Entry, Extrapolate, Inspection, Model,
-    Stepping, Structure, UnknownSolver,
+    energy_audit, inspect, solver, structure, Check, CheckResult, EnergyRun, Entry, Extrapolate,
+    Inspection, Model, Stepping, Structure, UnknownSolver,
 };
 pub use plots::{Panel, Plot, Series};
 pub use reader::{ElementSpec, RawValue};

@@ -8,6 +8,7 @@
 
 mod build;
 mod checks;
+mod energy;
 mod events;
 mod initial;
 mod inputs;
@@ -25,6 +26,7 @@ mod tables;
 mod wire;
 
 pub use checks::{Check, CheckResult};
+pub use energy::{energy_audit, EnergyRun};
 pub use inputs::Extrapolate;
 pub use inspect::{inspect, Inspection};
 pub use model::Model;

@@ -72,6 +72,10 @@ pub struct Args {
     /// solver's error control alone deals with the corners).
     #[arg(long)]
     pub no_breakpoints: bool,
+    /// Audit the run's energy (docs/energy.md): print where it went, by composite, after the
+    /// run, and write every element's row to OUT.energy.csv beside the results.
+    #[arg(long)]
+    pub energy: bool,
 }
 
 /// How `run` drives the model's inputs (`--inputs`, `--inputs-interp`,
@@ -129,6 +133,7 @@ pub fn command(a: Args) -> ExitCode {
         inputs_interp,
         inputs_extrapolate,
         no_breakpoints,
+        energy,
     } = a;
     let drive = InputOptions {
         data: inputs,
@@ -151,6 +156,7 @@ pub fn command(a: Args) -> ExitCode {
         &set,
         quiet,
         &drive,
+        energy,
         &mut facts,
     );
     if format == Format::Json {
@@ -183,6 +189,7 @@ fn run(
     set: &[String],
     quiet: bool,
     drive: &InputOptions,
+    energy: bool,
     facts: &mut Facts,
 ) -> (ExitCode, Option<PathBuf>) {
     let refuse = |facts: &mut Facts, m: String| {
@@ -265,7 +272,15 @@ fn run(
         !quiet && std::io::IsTerminal::is_terminal(&std::io::stderr()),
         !model.checks.is_empty(),
     );
-    let ran = model.run_into(&mut progress);
+    let mut audit = None;
+    let ran = if energy {
+        model.run_energy(&mut progress).map(|r| {
+            audit = Some(r.report);
+            (r.outcome, r.checks)
+        })
+    } else {
+        model.run_into(&mut progress)
+    };
     drop(progress);
     let (outcome, checks) = match ran {
         Ok(r) => r,
@@ -333,6 +348,20 @@ fn run(
         }
     }
     let mut code = ExitCode::SUCCESS;
+    if let Some(report) = &audit {
+        let csv = out_path.with_extension("energy.csv");
+        if !quiet {
+            say!("{}", bg_sim::energy::text(report, false).trim_end());
+        }
+        match std::fs::write(&csv, bg_sim::energy::csv(report, true)) {
+            Ok(()) if !quiet => say!("wrote the energy of every element to {}", csv.display()),
+            Ok(()) => {}
+            Err(e) => {
+                tell!("error: cannot write {}: {e}", csv.display());
+                code = ExitCode::from(FAILED);
+            }
+        }
+    }
     if let Some(e) = &error {
         tell!("error: {}: the run stopped early: {e}", model.file());
         match sink.last_t {

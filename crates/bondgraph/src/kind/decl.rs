@@ -392,8 +392,79 @@ impl fmt::Debug for Build {
     }
 }
 
+/// One change a [`Simplification`] makes to the parameters of an instance of its kind,
+/// written as a model file writes them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Change {
+    /// Set parameter `key` to `value` (TOML: `"0"`, `"1"`, `"\"rigid\""`). A key
+    /// `list[*].key` sets `key` in every entry of the list of tables `list` that has it
+    /// (`links[*].modes`: every beam).
+    Set(&'static str, &'static str),
+    /// Remove parameter `key`: the instance gets what its absence declares ("no internal
+    /// leakage", "no dynamics").
+    Unset(&'static str),
+}
+
+impl Change {
+    /// The parameter it changes (`links[*].modes`, `r_int`).
+    #[must_use]
+    pub fn key(&self) -> &'static str {
+        match self {
+            Self::Set(k, _) | Self::Unset(k) => k,
+        }
+    }
+}
+
+impl fmt::Display for Change {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Set(k, v) => write!(f, "{k} = {v}"),
+            Self::Unset(k) => write!(f, "no {k}"),
+        }
+    }
+}
+
+/// A simpler law an instance of a kind can be reduced to (the activity-based reduction of
+/// Louca and Stein, MORA: an element whose share of the energy flow over a scene is small is
+/// removed or simplified): a name, what it does, the members whose energy flow it removes,
+/// and the parameter changes that make it. The reducer (`bg-sim reduce --by activity`)
+/// applies the changes to the model file's entry without knowing the kind.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Simplification {
+    /// A short name (`no_internal_leakage`, `rigid_lumped_masses`).
+    pub name: &'static str,
+    /// One line: what the simplified instance is.
+    pub doc: &'static str,
+    /// The members of a composite whose energy flow the simplification removes, by their
+    /// local names (`leak`; [`super::member_name`] gives the global ones); empty: the whole
+    /// element. The sum of their activity shares is what the reducer compares with its
+    /// threshold, so it must bound the energy flow the simplification takes away.
+    pub members: &'static [&'static str],
+    /// The parameter changes, applied in order.
+    pub changes: &'static [Change],
+}
+
+impl Simplification {
+    /// A simplification of the whole element.
+    #[must_use]
+    pub const fn new(name: &'static str, doc: &'static str, changes: &'static [Change]) -> Self {
+        Self {
+            name,
+            doc,
+            members: &[],
+            changes,
+        }
+    }
+    /// Whose energy flow it removes: these members of the composite.
+    #[must_use]
+    pub const fn members(mut self, members: &'static [&'static str]) -> Self {
+        self.members = members;
+        self
+    }
+}
+
 /// An element kind: its name in model files, one line of summary, its parameters, a builder,
-/// and a complete example of its parameters (what `bg-sim kinds NAME` builds to list ports,
+/// the simplifications it can be reduced to, and a complete example of its parameters (what `bg-sim kinds NAME` builds to list ports,
 /// states and published variables, and what the tests build).
 #[derive(Clone, Copy, Debug)]
 pub struct KindDecl {
@@ -408,6 +479,8 @@ pub struct KindDecl {
     /// The parameters of a working instance, as a model file writes them inside `{ … }`
     /// (`"beta = 1.5e9, volume = 1e-3"`); signals it names are listed as inputs.
     pub example: &'static str,
+    /// What an instance can be simplified to ([`Simplification`]), richest first.
+    pub simplifications: &'static [Simplification],
 }
 
 impl KindDecl {
@@ -425,6 +498,7 @@ impl KindDecl {
             params,
             build: Build::Element(build),
             example: "",
+            simplifications: &[],
         }
     }
     /// A kind that expands into a sub-graph.
@@ -441,6 +515,7 @@ impl KindDecl {
             params,
             build: Build::Composite(build),
             example: "",
+            simplifications: &[],
         }
     }
     /// With this example.
@@ -448,6 +523,19 @@ impl KindDecl {
     pub const fn example(mut self, example: &'static str) -> Self {
         self.example = example;
         self
+    }
+
+    /// With these simplifications.
+    #[must_use]
+    pub const fn simplifications(mut self, simplifications: &'static [Simplification]) -> Self {
+        self.simplifications = simplifications;
+        self
+    }
+
+    /// The simplification called `name`.
+    #[must_use]
+    pub fn simplification(&self, name: &str) -> Option<&'static Simplification> {
+        self.simplifications.iter().find(|s| s.name == name)
     }
 
     /// The declaration of parameter `name`.

@@ -33,7 +33,8 @@ pub mod units;
 
 pub use composite::{member_name, Composite, Expanded};
 pub use decl::{
-    number, Build, CompositeBuilder, Default, ElementBuilder, KindDecl, ParamDecl, ParamType, Range,
+    number, Build, Change, CompositeBuilder, Default, ElementBuilder, KindDecl, ParamDecl,
+    ParamType, Range, Simplification,
 };
 pub use params::{BuildError, BuildErrorKind, MatrixEntry, MatrixParam, Params};
 pub use suggest::{similar, suggest};

@@ -47,7 +47,7 @@ mod watch;
 
 pub use outcome::{Event, Outcome, Statistics, Trajectory, WatchReport};
 pub use record::{Output, RowSink};
-pub use run::{simulate, simulate_into};
+pub use run::{simulate, simulate_audited, simulate_into};
 pub use settings::{
     check_in_memory, Method, Settings, MAX_OUTPUT_ROWS, MAX_VALUES_IN_MEMORY, MIN_RTOL,
 };

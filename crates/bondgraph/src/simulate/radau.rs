@@ -130,6 +130,9 @@ impl Stepper for RadauStepper<'_> {
             .map_err(|e| e.to_string())?;
         Ok(y)
     }
+    fn interpolate_into(&self, t: f64, out: &mut [f64]) -> Result<(), String> {
+        self.radau.interpolate(t, out).map_err(|e| e.to_string())
+    }
     fn work(&self) -> Work {
         let s = self.radau.stats();
         Work {

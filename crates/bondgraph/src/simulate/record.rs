@@ -97,6 +97,8 @@ pub(super) struct Recorder<'e> {
     pub(super) event_at: Option<f64>,
     pub(super) buf: Vec<f64>,
     pub(super) p: Progress,
+    /// The energy audit fed after every accepted step ([`super::simulate_audited`]), if any.
+    pub(super) audit: Option<&'e mut crate::energy::EnergyAudit>,
 }
 
 impl Recorder<'_> {

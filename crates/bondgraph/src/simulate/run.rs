@@ -62,8 +62,23 @@ pub fn simulate_into(
     x0: &[f64],
     settings: &Settings,
     outputs: &[Output],
+    events: Vec<Event>,
+    sink: &mut dyn RowSink,
+) -> Outcome {
+    simulate_audited(eqs, x0, settings, outputs, events, sink, None)
+}
+
+/// [`simulate_into`] with an energy audit ([`crate::energy`]) fed after every accepted step
+/// (`None`: exactly [`simulate_into`]). Read the audit with
+/// [`EnergyAudit::report`](crate::energy::EnergyAudit::report) afterwards.
+pub fn simulate_audited(
+    eqs: &mut StateEquations,
+    x0: &[f64],
+    settings: &Settings,
+    outputs: &[Output],
     mut events: Vec<Event>,
     sink: &mut dyn RowSink,
+    mut audit: Option<&mut crate::energy::EnergyAudit>,
 ) -> Outcome {
     let mut out = start_outcome(settings, outputs, x0);
     if let Err(e) = settings.validate() {
@@ -147,7 +162,11 @@ pub fn simulate_into(
             event_at: (t_event < t_end && same_time(t_event, t_stop)).then_some(t_stop),
             buf: std::mem::take(&mut buf),
             p: progress,
+            audit: audit.as_deref_mut(),
         };
+        if let Some(a) = rec.audit.as_deref_mut() {
+            a.begin_segment(rec.eqs, t, &x);
+        }
         // The step that reached an event time, after the switch.
         if switched && wants_steps && t > t0 {
             rec.step_values(t, &x);
@@ -170,6 +189,13 @@ pub fn simulate_into(
                 &mut out.stats,
             ))
         };
+        if let Some(a) = rec.audit.as_deref_mut() {
+            match &seg {
+                Some(Ok(xs)) => a.end_segment(rec.eqs, t_stop, xs),
+                Some(Err((te, xe, _))) => a.end_segment(rec.eqs, *te, xe),
+                None => a.end_segment(rec.eqs, t, &x),
+            }
+        }
         // A row refused at the end of the segment stops the run here.
         let refused = rec.p.stop.take();
         buf = rec.buf;

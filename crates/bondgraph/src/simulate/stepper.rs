@@ -43,6 +43,12 @@ pub(super) trait Stepper {
     fn y(&self) -> Vec<f64>;
     /// The state at `t` inside the last step.
     fn interpolate(&self, t: f64) -> Result<Vec<f64>, String>;
+    /// [`Stepper::interpolate`] into `out` (the energy audit's nodes; Radau without
+    /// allocating).
+    fn interpolate_into(&self, t: f64, out: &mut [f64]) -> Result<(), String> {
+        out.copy_from_slice(&self.interpolate(t)?);
+        Ok(())
+    }
     /// Work so far.
     fn work(&self) -> Work;
 }
@@ -123,6 +129,7 @@ pub(super) fn drive(
         culprit,
         hint: None,
     };
+    let mut t_prev = s.t_h().0;
     loop {
         let step = s.step();
         let (t, h) = s.t_h();
@@ -182,6 +189,23 @@ pub(super) fn drive(
             _ => None,
         };
         let t_rows = root.map_or(t, |(tr, _)| tr);
+        // The energy audit: the power at the step's quadrature nodes (`crate::energy`).
+        if let Some(audit) = rec.audit.as_deref_mut() {
+            let audited = if root.is_some() {
+                let mut xr = x.clone();
+                s.interpolate_into(t_rows, &mut xr).and_then(|()| {
+                    audit.step(eqs, t_prev, t_rows, &xr, |tq, y| s.interpolate_into(tq, y))
+                })
+            } else {
+                audit.step(eqs, t_prev, t, &x, |tq, y| s.interpolate_into(tq, y))
+            };
+            if let Err(e) = audited {
+                finish(s, stats);
+                let message = format!("energy audit at t = {t}: {e}");
+                return Err((t, x, solver_error(t, message, String::new())));
+            }
+        }
+        t_prev = t;
         while let Some(tg) = rec.pending() {
             if tg > t_rows
                 || same_time(tg, t_stop)

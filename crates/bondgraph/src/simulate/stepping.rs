@@ -393,6 +393,7 @@ impl Simulation {
                 rows: 0,
                 stop: None,
             },
+            audit: None,
         };
         let mut stepper = RadauStepper {
             radau,

@@ -110,6 +110,11 @@ impl Element for ArmCompliance {
     fn kind(&self) -> &str {
         "manipulator.c_field"
     }
+    fn energy_role(&self, _: usize) -> bondgraph::EnergyRole {
+        // Stores V(q) = V_g(q) + ½qᵀKq; q is the I-field's state, so the audit integrates
+        // the port power, which is exactly dV/dt.
+        bondgraph::EnergyRole::Storage
+    }
     fn ports(&self) -> Ports {
         Ports::Fixed(vec![PortSpec::new("1", self.arm.n())])
     }

@@ -232,7 +232,7 @@ impl Model {
 
     /// Run `simulate` with the model's events, then restore the elements the events
     /// replaced (those entries alone, built with the model's values).
-    fn run_events(
+    pub(super) fn run_events(
         &mut self,
         simulate: impl FnOnce(
             &mut StateEquations,
