@@ -69,7 +69,26 @@ fn fuzz<S: Strategy>(
         cases()
     );
     let start = Instant::now();
-    let result = runner(seed).run(strategy, test);
+    // progress for long local sweeps (a killed run still says how far it got): a line every
+    // `BG_FUZZ_PROGRESS` cases (default 10 000; CI's few hundred print none)
+    let every: u64 = std::env::var("BG_FUZZ_PROGRESS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(10_000)
+        .max(1);
+    let done = std::cell::Cell::new(0u64);
+    let result = runner(seed).run(strategy, |v| {
+        let r = test(v);
+        done.set(done.get() + 1);
+        if done.get() % every == 0 {
+            eprintln!(
+                "{target}: {} cases run in {:.1} s (seed {seed})",
+                done.get(),
+                start.elapsed().as_secs_f64()
+            );
+        }
+        r
+    });
     eprintln!(
         "{target}: {} inputs in {:.1} s (seed {seed})",
         cases(),
