@@ -12,7 +12,9 @@
 //! Cases: `BG_FUZZ_CASES` (default 300 per target, a few seconds in CI). Seed: `BG_FUZZ_SEED`,
 //! or else the commit under test (the first 16 hex digits of `git rev-parse HEAD`, so each
 //! commit explores new inputs), or else (no git) a fixed one. Each target prints its seed,
-//! and a failure names it: `BG_FUZZ_SEED=N` reproduces it. A local sweep:
+//! and a failure names it: `BG_FUZZ_SEED=N` reproduces it. A long run prints a line every
+//! `BG_FUZZ_PROGRESS` cases (default 10 000), so a run stopped early says how far it got.
+//! A local sweep:
 //! `BG_FUZZ_CASES=500000 BG_FUZZ_SEED=7 cargo test -p bg-tests --test fuzz -- --nocapture`.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 

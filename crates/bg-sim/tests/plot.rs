@@ -429,5 +429,5 @@ fn plot_of_a_big_csv_draws_a_bounded_number_of_points_and_keeps_the_peaks() {
         .iter()
         .filter(|p| p.1 < top + 0.9 * (bottom - top))
         .count();
-    assert!(spike >= 1 && spike <= 3, "{spike} points near the top");
+    assert!((1..=3).contains(&spike), "{spike} points near the top");
 }

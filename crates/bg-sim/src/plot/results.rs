@@ -362,7 +362,8 @@ fn envelope(columns: &[Vec<f64>], start: usize, end: usize, keep: &mut Vec<usize
 }
 
 #[cfg(test)]
-#[allow(clippy::unwrap_used)]
+// values held are copies of the file's, compared exactly
+#[allow(clippy::unwrap_used, clippy::float_cmp)]
 mod tests {
     use super::*;
 
