@@ -12,7 +12,9 @@
 //! Cases: `BG_FUZZ_CASES` (default 300 per target, a few seconds in CI). Seed: `BG_FUZZ_SEED`,
 //! or else the commit under test (the first 16 hex digits of `git rev-parse HEAD`, so each
 //! commit explores new inputs), or else (no git) a fixed one. Each target prints its seed,
-//! and a failure names it: `BG_FUZZ_SEED=N` reproduces it. A local sweep:
+//! and a failure names it: `BG_FUZZ_SEED=N` reproduces it. A long run prints a line every
+//! `BG_FUZZ_PROGRESS` cases (default 10 000), so a run stopped early says how far it got.
+//! A local sweep:
 //! `BG_FUZZ_CASES=500000 BG_FUZZ_SEED=7 cargo test -p bg-tests --test fuzz -- --nocapture`.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -69,7 +71,26 @@ fn fuzz<S: Strategy>(
         cases()
     );
     let start = Instant::now();
-    let result = runner(seed).run(strategy, test);
+    // progress for long local sweeps (a killed run still says how far it got): a line every
+    // `BG_FUZZ_PROGRESS` cases (default 10 000; CI's few hundred print none)
+    let every: u64 = std::env::var("BG_FUZZ_PROGRESS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(10_000)
+        .max(1);
+    let done = std::cell::Cell::new(0u64);
+    let result = runner(seed).run(strategy, |v| {
+        let r = test(v);
+        done.set(done.get() + 1);
+        if done.get() % every == 0 {
+            eprintln!(
+                "{target}: {} cases run in {:.1} s (seed {seed})",
+                done.get(),
+                start.elapsed().as_secs_f64()
+            );
+        }
+        r
+    });
     eprintln!(
         "{target}: {} inputs in {:.1} s (seed {seed})",
         cases(),

@@ -12,12 +12,13 @@
 //! around its members.
 //!
 //! The layout is our own layered drawing ([`layout`]): composites expanded are laid out
-//! on their own first and placed as one block.
+//! on their own first and placed as one block. A PNG is that SVG rendered ([`png`]).
 
 mod dot;
 mod drawing;
 pub mod layout;
 mod place;
+pub mod png;
 mod svg;
 
 pub use dot::dot;
@@ -139,6 +140,18 @@ pub enum Format {
     Svg,
     /// Graphviz DOT, for `dot -Tsvg` or `dot -Tpdf`.
     Dot,
+    /// The SVG drawing rendered to pixels (no viewer or Graphviz needed).
+    Png,
+}
+
+impl Format {
+    fn extension(self) -> &'static str {
+        match self {
+            Format::Svg => "svg",
+            Format::Dot => "dot",
+            Format::Png => "png",
+        }
+    }
 }
 
 /// What [`write`] wrote.
@@ -155,13 +168,15 @@ pub struct Written {
 }
 
 /// `bg-sim graph`: load `model` (with `--set` overrides) as far as its causality, draw it and
-/// write it to `out` (default `out/<model>.svg`, or `.dot`); the format is `format`, else
-/// the extension of `out` (`.dot`/`.gv`: DOT), else SVG.
+/// write it to `out` (default `out/<model>.svg`, `.dot` or `.png`); the format is `format`,
+/// else the extension of `out` (`.dot`/`.gv`: DOT, `.png`: PNG), else SVG. A PNG is the SVG
+/// rendered at `scale` pixels per SVG pixel.
 pub fn write(
     model: &std::path::Path,
     out: Option<&std::path::Path>,
     expand: bool,
     format: Option<Format>,
+    scale: f32,
     set: &[String],
 ) -> Result<Written, String> {
     let format = format.unwrap_or_else(|| {
@@ -172,6 +187,7 @@ pub fn write(
             .as_deref()
         {
             Some("dot" | "gv") => Format::Dot,
+            Some("png") => Format::Png,
             _ => Format::Svg,
         }
     });
@@ -180,8 +196,7 @@ pub fn write(
             let stem = model
                 .file_stem()
                 .map_or_else(|| "model".into(), |s| s.to_string_lossy().into_owned());
-            let ext = if format == Format::Dot { "dot" } else { "svg" };
-            std::path::PathBuf::from("out").join(format!("{stem}.{ext}"))
+            std::path::PathBuf::from("out").join(format!("{stem}.{}", format.extension()))
         },
         std::path::Path::to_path_buf,
     );
@@ -193,14 +208,15 @@ pub fn write(
     }
     let s = bg_model::structure(model, &crate::registry(), set).map_err(|e| e.to_string())?;
     let d = drawing(&s, expand);
-    let text = match format {
-        Format::Svg => svg(&d),
-        Format::Dot => dot(&d),
+    let bytes = match format {
+        Format::Svg => svg(&d).into_bytes(),
+        Format::Dot => dot(&d).into_bytes(),
+        Format::Png => png::png(&svg(&d), scale)?,
     };
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| format!("cannot write {}: {e}", dir.display()))?;
     }
-    std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    std::fs::write(&path, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     Ok(Written {
         path,
         nodes: d.nodes.len(),

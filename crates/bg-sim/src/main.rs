@@ -40,7 +40,7 @@ enum Command {
     SweepPlot(sweep::PlotArgs),
     /// Check a model: list elements, bonds with causal strokes, states and problems.
     Check(check::Args),
-    /// Draw a model's bond graph as SVG (or Graphviz DOT): element symbols, half-arrows,
+    /// Draw a model's bond graph as SVG or PNG (or Graphviz DOT): element symbols, half-arrows,
     /// causal strokes, signals; composites as one box each unless --expand (docs/graph.md).
     Graph(graph::Args),
     /// List the element kinds a model file can use, or describe one: its ports, parameters

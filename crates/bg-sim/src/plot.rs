@@ -28,7 +28,7 @@ pub use contour::{contour, Map};
 pub use energy::{energy_bars, energy_segments, Segment};
 pub use figure::{draw, draw_all};
 pub use quick::quick_look;
-pub use results::Results;
+pub use results::{not_a_regular_file, Results, PLOT_ROWS};
 pub use work_precision::{work_precision, WorkPrecisionLine};
 
 /// Why the figures could not be drawn.

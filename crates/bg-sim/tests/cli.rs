@@ -672,11 +672,12 @@ fn result_files_follow_the_umask() {
     assert_eq!(mode, 0o644);
 }
 
-/// #7: `bg-sim check /dev/zero` read until memory ran out.
+/// #7: `bg-sim check /dev/zero` read until memory ran out. A file `check` cannot read is bad
+/// input, exit 2 (issue 24: it was 1, the status of a model with problems).
 #[test]
 fn check_of_an_endless_file_is_refused() {
     let (code, out, _) = run_ok(&[os("check"), os("/dev/zero")]);
-    assert_eq!(code, 1);
+    assert_eq!(code, 2);
     assert!(out.contains("larger than 16 MiB"), "{out}");
 }
 

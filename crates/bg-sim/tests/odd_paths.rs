@@ -90,12 +90,88 @@ fn a_model_path_that_is_a_directory_or_a_fifo_is_refused_by_every_command() {
                 String::from_utf8_lossy(&o.stdout),
                 String::from_utf8_lossy(&o.stderr)
             );
-            // check reports problems (exit 1), the others refuse bad input (exit 2)
-            let want = if args[0] == "check" { 1 } else { 2 };
-            assert_eq!(o.status.code(), Some(want), "{args:?}: {text}");
+            // bad input, exit 2 — `check` too: a model it cannot read is not one with
+            // problems (exit 1 before)
+            assert_eq!(o.status.code(), Some(2), "{args:?}: {text}");
             assert!(
                 text.contains(&format!("it is {what}")) && text.contains("not a model file"),
                 "{args:?}: {text}"
+            );
+        }
+    }
+}
+
+/// `check` of a model it cannot read at all (missing) is bad input, exit 2 (it was 1, the
+/// status of a model with problems); a model with problems stays 1.
+#[test]
+fn check_of_an_unreadable_model_is_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("nowhere.toml");
+    for format in ["text", "json"] {
+        let o = within(bg_sim().args(["check", "--format", format]).arg(&missing)).unwrap();
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert_eq!(o.status.code(), Some(2), "{format}: {text}");
+        assert!(text.contains("nowhere.toml"), "{format}: {text}");
+    }
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, "[elements]\nm = { kind = \"I\" }\n").unwrap();
+    let o = within(bg_sim().arg("check").arg(&bad)).unwrap();
+    assert_eq!(o.status.code(), Some(1), "{o:?}");
+}
+
+/// A FIFO (or a directory) given where a results CSV, a sweep spec or a sweep summary is
+/// read is refused at once, exit 2, naming it — before, a FIFO without a writer blocked
+/// `plot`, `compare`, `sweep --spec` and `sweep-plot` for ever in `read_to_string`.
+#[test]
+fn a_fifo_or_a_directory_as_results_spec_or_summary_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("r.csv");
+    std::fs::write(&csv, "t,x\n0,1\n1,2\n").unwrap();
+    let fifo = dir.path().join("pipe.csv");
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    let folder = dir.path().join("folder.csv");
+    std::fs::create_dir(&folder).unwrap();
+    let msd =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../models/mass_spring_damper.toml");
+    let out = dir.path().join("out");
+    for (odd, what) in [(&fifo, "a FIFO"), (&folder, "a directory")] {
+        let png = out.join("s.png");
+        let cases: Vec<Vec<&dyn AsRef<std::ffi::OsStr>>> = vec![
+            vec![&"plot", odd, &"--columns", &"x", &"-o", &out],
+            vec![&"plot", odd, &"--model", &msd, &"-o", &out],
+            vec![&"compare", odd, &csv],
+            vec![&"compare", &csv, odd],
+            vec![&"sweep", &msd, &"--spec", odd, &"-o", &out],
+            vec![
+                &"sweep-plot",
+                odd,
+                &"--x",
+                &"a",
+                &"--y",
+                &"b",
+                &"--z",
+                &"c",
+                &"-o",
+                &png,
+            ],
+        ];
+        for args in cases {
+            let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_ref()).collect();
+            let o = within(bg_sim().args(&args))
+                .unwrap_or_else(|| panic!("{args:?}: still waiting after 30 s"));
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+            assert!(
+                err.contains(&format!("it is {what}")) && err.contains(&*odd.to_string_lossy()),
+                "{args:?}: {err}"
             );
         }
     }

@@ -9,6 +9,7 @@ use bg_sim::registry;
 use serde_json::json;
 
 use super::json::{problems, Format};
+use super::{BAD_INPUT, FAILED};
 
 /// The options of `bg-sim check` (its summary is on `Command::Check` in main.rs).
 #[derive(clap::Args)]
@@ -33,7 +34,7 @@ pub fn command(a: &Args) -> ExitCode {
 
 /// `check --format json`: `{file, ok, elements: [{name, kind, line}], states: [{name,
 /// initial}], problems: [..], notes: [..]}` with problems and notes as [`problems`] writes
-/// them; exit 1 if there are problems.
+/// them; exit 1 if there are problems, 2 if the model could not be read.
 fn check_json(path: &Path, set: &[String]) -> ExitCode {
     let report = inspect(path, &registry(), set);
     let elements: Vec<_> = report
@@ -63,10 +64,18 @@ fn check_json(path: &Path, set: &[String]) -> ExitCode {
         "problems": problems(&report.problems),
         "notes": problems(&report.notes),
     }));
-    if report.problems.is_empty() {
+    status(&report.problems)
+}
+
+/// 0 without problems; 2 if the model could not be read (a missing or unreadable file, a
+/// directory, a FIFO: bad input, nothing was checked); else 1, problems found.
+fn status(problems: &[bg_model::ModelError]) -> ExitCode {
+    if problems.is_empty() {
         ExitCode::SUCCESS
+    } else if problems.iter().any(|p| p.kind == bg_model::ErrorKind::Io) {
+        ExitCode::from(BAD_INPUT)
     } else {
-        ExitCode::from(1)
+        ExitCode::from(FAILED)
     }
 }
 
@@ -139,7 +148,7 @@ fn check(path: &Path, set: &[String]) -> ExitCode {
         if let Some(rest) = rest_by_kind(&report.problems) {
             say!("  {rest}");
         }
-        ExitCode::from(1)
+        status(&report.problems)
     }
 }
 

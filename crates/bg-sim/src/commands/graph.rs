@@ -1,4 +1,4 @@
-//! `bg-sim graph`: draw a model's bond graph as SVG or DOT ([`bg_sim::graph`]).
+//! `bg-sim graph`: draw a model's bond graph as SVG, PNG or DOT ([`bg_sim::graph`]).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -10,15 +10,18 @@ use super::BAD_INPUT;
 pub struct Args {
     /// The model file.
     pub model: PathBuf,
-    /// Output file (default: out/<model name>.svg, or .dot).
+    /// Output file (default: out/<model name>.svg, or .dot, .png).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Draw the members of every composite inside a frame instead of one box.
     #[arg(long)]
     pub expand: bool,
-    /// svg or dot (default: from the extension of --output, else svg).
+    /// svg, dot or png (default: from the extension of --output, else svg).
     #[arg(long, value_enum)]
     pub format: Option<bg_sim::graph::Format>,
+    /// PNG only: pixels per SVG pixel (2: a 737 px wide drawing becomes 1474 px).
+    #[arg(long, default_value_t = bg_sim::graph::png::DEFAULT_SCALE)]
+    pub scale: f32,
     /// Override a value of the model file (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
@@ -31,9 +34,10 @@ pub fn command(a: Args) -> ExitCode {
         output,
         expand,
         format,
+        scale,
         set,
     } = a;
-    graph(&model, output.as_deref(), expand, format, &set)
+    graph(&model, output.as_deref(), expand, format, scale, &set)
 }
 
 fn graph(
@@ -41,9 +45,10 @@ fn graph(
     out: Option<&Path>,
     expand: bool,
     format: Option<bg_sim::graph::Format>,
+    scale: f32,
     set: &[String],
 ) -> ExitCode {
-    match bg_sim::graph::write(model, out, expand, format, set) {
+    match bg_sim::graph::write(model, out, expand, format, scale, set) {
         Ok(w) => {
             if let Some(p) = &w.problem {
                 tell!("note: drawn without causal strokes: {p}");

@@ -67,33 +67,62 @@ pub fn plot(results: &Path, what: PlotWhat<'_>, dir: &Path, format: &str, quiet:
         tell!("error: --format {format}: expected png, svg or both");
         return ExitCode::from(BAD_INPUT);
     };
-    let table = match Results::read(results) {
+    // the model first: its plots say which columns to read (a big CSV is read for those only)
+    let model = match what {
+        PlotWhat::Model(path, set) => match Model::load(path, &registry(), set) {
+            Ok(m) => {
+                if m.plots().is_empty() {
+                    tell!(
+                        "error: {} has no [[plot]] tables\n  hint: add one (docs/model-format.md, section Plots), or look at columns with `bg-sim plot {} --columns a,b`",
+                        path.display(),
+                        results.display()
+                    );
+                    return ExitCode::from(FAILED);
+                }
+                Some(m)
+            }
+            Err(e) => {
+                tell!("error: {e}");
+                return ExitCode::from(BAD_INPUT);
+            }
+        },
+        _ => None,
+    };
+    let wanted: Vec<&str> = match (&model, &what) {
+        (Some(m), _) => m
+            .plots()
+            .iter()
+            .flat_map(|p| {
+                std::iter::once(p.x.as_str()).chain(
+                    p.panels
+                        .iter()
+                        .flat_map(|panel| panel.series.iter().map(|s| s.column.as_str())),
+                )
+            })
+            .collect(),
+        (None, PlotWhat::Columns(c)) => c.iter().map(String::as_str).collect(),
+        (None, _) => Vec::new(),
+    };
+    let table = match Results::read_for_plot(results, &wanted) {
         Ok(t) => t,
         Err(e) => {
             tell!("error: {e}");
             return ExitCode::from(BAD_INPUT);
         }
     };
-    let drawn = match what {
-        PlotWhat::Model(path, set) => {
-            let model = match Model::load(path, &registry(), set) {
-                Ok(m) => m,
-                Err(e) => {
-                    tell!("error: {e}");
-                    return ExitCode::from(BAD_INPUT);
-                }
-            };
-            if model.plots().is_empty() {
-                tell!(
-                    "error: {} has no [[plot]] tables\n  hint: add one (docs/model-format.md, section Plots), or look at columns with `bg-sim plot {} --columns a,b`",
-                    path.display(),
-                    results.display()
-                );
-                return ExitCode::from(FAILED);
-            }
+    if table.bucket() > 1 && !quiet {
+        tell!(
+            "note: {} rows: drawn from {} (each run of {} rows keeps its first, last, smallest and largest values)",
+            table.rows_read(),
+            table.rows_held(),
+            table.bucket()
+        );
+    }
+    let drawn = match (what, &model) {
+        (PlotWhat::Model(..), Some(model)) => {
             draw_all(&table, model.plots(), model.file(), dir, format)
         }
-        PlotWhat::Columns(columns) => {
+        (PlotWhat::Columns(columns), _) => {
             let stem = results.file_stem().map_or_else(
                 || "columns".to_owned(),
                 |s| s.to_string_lossy().into_owned(),
@@ -106,7 +135,7 @@ pub fn plot(results: &Path, what: PlotWhat<'_>, dir: &Path, format: &str, quiet:
                 draw(&table, &p, dir, format)
             })
         }
-        PlotWhat::Nothing => {
+        _ => {
             tell!(
                 "error: say what to draw: --model MODEL.toml (its [[plot]] tables) or --columns a,b (a quick look)\n  hint: {} has the columns {}",
                 results.display(),

@@ -81,8 +81,8 @@ pub fn plot_command(a: &PlotArgs) -> ExitCode {
 fn sweep(model: &Path, spec: &Path, jobs: usize, out_dir: PathBuf) -> ExitCode {
     use bg_sim::sweep::{parse_spec, sweep, Options};
     let shown = spec.display().to_string();
-    let parsed = std::fs::read_to_string(spec)
-        .map_err(|e| format!("{shown}: {e}"))
+    let parsed = regular(spec)
+        .and_then(|()| std::fs::read_to_string(spec).map_err(|e| format!("{shown}: {e}")))
         .and_then(|t| parse_spec(&shown, &t).map_err(|e| e.to_string()));
     let spec = match parsed {
         Ok(s) => s,
@@ -178,6 +178,7 @@ fn sweep_map(
     cols: [&String; 3],
     scale: &[f64],
 ) -> Result<bg_sim::plot::Map, String> {
+    regular(summary)?;
     let (head, rows) = bg_sim::sweep::read_summary(summary).map_err(|e| e.to_string())?;
     let mut idx = [0usize; 3];
     for (k, c) in cols.iter().enumerate() {
@@ -220,5 +221,17 @@ fn rayon_threads(jobs: usize) -> usize {
         jobs
     } else {
         std::thread::available_parallelism().map_or(1, std::num::NonZero::get)
+    }
+}
+
+/// Err if `path` is a FIFO, a socket, a directory or a device: a FIFO without a writer
+/// blocked `read_to_string` for ever (issue 24, item 10).
+fn regular(path: &Path) -> Result<(), String> {
+    match bg_sim::plot::not_a_regular_file(path) {
+        None => Ok(()),
+        Some(what) => Err(format!(
+            "{}: cannot read: it is {what}, not a file\n  hint: write piped text to a file first",
+            path.display()
+        )),
     }
 }
