@@ -517,7 +517,14 @@ pub fn solve_steady(
         // Scaled Newton step: A·Δ = −s with A_ij = J_ij·c_j/s_i.
         let j = p.jacobian(&x);
         let a = DMatrix::from_fn(m, m, |i, k| j[(i, k)] * p.col_scale[k] / p.row_scale[i]);
-        let svd = a.svd(true, true);
+        // A non-finite entry would keep nalgebra's SVD iterating forever (found by the loader
+        // fuzzer on a mutated lift circuit): stop here, and bound the iterations otherwise.
+        if a.iter().any(|v| !v.is_finite()) {
+            break;
+        }
+        let Some(svd) = a.try_svd(true, true, f64::EPSILON, 1000 + 100 * m) else {
+            break;
+        };
         let (smax, smin, kmin) = svd.singular_values.iter().enumerate().fold(
             (0.0f64, f64::INFINITY, 0),
             |(mx, mn, k), (i, &v)| {
@@ -675,6 +682,63 @@ mod tests {
         assert!(e
             .to_string()
             .contains("2 unknowns (spring.q, mass.p) but 1 conditions"));
+    }
+
+    #[test]
+    fn a_jacobian_that_turns_non_finite_ends_the_solve_instead_of_panicking() {
+        // Two masses on springs; the first force F(q) = 1 − 3q − q² has a gradient that is NaN
+        // once q leaves the start: the first Newton step lands at q = 0.25 with finite
+        // residuals and a NaN in the Jacobian. Before, nalgebra's SVD of that Jacobian panicked
+        // (sorting NaN singular values) or, on the loader fuzzer's mutated lift circuit, never
+        // returned; now the solve stops with "no equilibrium found".
+        let mut g = BondGraph::new();
+        let law = crate::Param::modulated_exact(
+            vec!["spring.q".into()],
+            |_, u| 1.0 - 3.0 * u[0] - u[0] * u[0],
+            |_, u, grad| {
+                grad[0] = if u[0].abs() < 0.1 {
+                    -3.0 - 2.0 * u[0]
+                } else {
+                    f64::NAN
+                };
+                1.0 - 3.0 * u[0] - u[0] * u[0]
+            },
+        );
+        g.add("force", EffortSource::new(law)).unwrap();
+        g.add("force2", EffortSource::new(2.0)).unwrap();
+        for (j, m, k) in [("v", "mass", "spring"), ("v2", "mass2", "spring2")] {
+            g.add(j, OneJunction).unwrap();
+            g.add(m, Inertia::new(1.0, 0.0).unwrap()).unwrap();
+            g.add(k, Capacitor::new(1.0, 0.0).unwrap()).unwrap();
+        }
+        for (a, b) in [
+            ("force", "v"),
+            ("v", "mass"),
+            ("v", "spring"),
+            ("force2", "v2"),
+            ("v2", "mass2"),
+            ("v2", "spring2"),
+        ] {
+            g.connect_names(a, b).unwrap();
+        }
+        let eqs = StateEquations::new(assign_causality(g).unwrap()).unwrap();
+        let (q, p) = (index(&eqs, "spring.q"), index(&eqs, "mass.p"));
+        let (q2, p2) = (index(&eqs, "spring2.q"), index(&eqs, "mass2.p"));
+        let req = SteadyRequest::new(
+            vec![q, q2],
+            vec![
+                Condition::Derivative {
+                    state: p,
+                    value: 0.0,
+                },
+                Condition::Derivative {
+                    state: p2,
+                    value: 0.0,
+                },
+            ],
+        );
+        let e = solve_steady(&eqs, 0.0, &eqs.initial_state(), &req).unwrap_err();
+        assert!(matches!(e, EquilibriumError::NoEquilibrium { .. }), "{e}");
     }
 
     #[test]
