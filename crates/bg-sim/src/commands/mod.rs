@@ -8,6 +8,7 @@ use std::sync::Arc;
 pub mod bench;
 pub mod check;
 pub mod compare;
+pub mod fmu;
 pub mod graph;
 pub mod json;
 pub mod kinds;
