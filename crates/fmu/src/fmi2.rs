@@ -13,7 +13,9 @@ use std::ptr;
 use crate::ffi::{guard, instance, resource_dir, run, slice, slice_mut, text};
 use crate::instance::{Failure, Instance, Log, Snapshot, Status};
 
-/// `fmi2CallbackLogger`: printf-like, so the message is passed as `"%s"`'s argument.
+/// `fmi2CallbackLogger`: the message is a printf format (variadic). It is passed with `%`
+/// doubled and no arguments, so importers that format it and importers that print it as
+/// it is (FMPy) both show the text.
 pub type Fmi2Logger = unsafe extern "C" fn(
     env: *mut c_void,
     instance_name: *const c_char,
@@ -51,17 +53,16 @@ fn logger(functions: Fmi2CallbackFunctions, name: &str) -> Log {
     let name = c_string(name);
     Box::new(move |status: Status, category: &str, message: &str| {
         if let Some(log) = functions.logger {
-            let (category, message) = (c_string(category), c_string(message));
+            let (category, message) = (c_string(category), c_string(&message.replace('%', "%%")));
             // SAFETY: the importer's logger, called as fmi2Functions.h declares it, with
-            // NUL-terminated strings that live through the call and a "%s" format whose one
-            // argument is a C string.
+            // NUL-terminated strings that live through the call and a format without
+            // conversions (every `%` doubled), so no variadic argument is read.
             unsafe {
                 log(
                     functions.component_environment,
                     name.as_ptr(),
                     status as c_int,
                     category.as_ptr(),
-                    c"%s".as_ptr(),
                     message.as_ptr(),
                 );
             }
