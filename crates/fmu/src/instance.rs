@@ -344,11 +344,8 @@ impl Instance {
             Role::Time => Ok(self.run.as_ref().map_or(self.start_time, Stepping::t)),
             Role::Input(_) | Role::Parameter(_) => Ok(self.values[vr as usize]),
             Role::Output(_) => {
-                let i = vr as usize;
-                let run = self.running()?;
-                let _ = run; // started
-                let probe = self.probes.get(i).copied().flatten();
-                match (probe, &self.run) {
+                self.running()?;
+                match (self.probes.get(vr as usize).copied().flatten(), &self.run) {
                     (Some(p), Some(r)) => Ok(r.read(p)),
                     _ => Err(Failure::error(format!("output {vr} is not readable"))),
                 }

@@ -216,7 +216,6 @@ pub fn export(
         })?;
         add(format!("resources/{}", slash(&rel(f))), &bytes, 0o644)?;
     }
-    drop(add);
     zip.finish()
         .map_err(|e| ExportError::File(format!("{}: cannot write: {e}", out.display())))?;
     Ok(Exported {

@@ -3,6 +3,7 @@
 //! input, step, read outputs, saved states, two instances, a broken model's error status
 //! and logged message, a panic caught at the boundary). FMPy checks the same FMUs from
 //! Python (crates/python/tests/test_fmu.py).
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::cell::RefCell;
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
@@ -299,7 +300,7 @@ fn fmi2_step_with_an_input_matches_the_analytic_response() {
     let c = instantiate2(&f, "a");
     assert!(!c.is_null());
     init2(c);
-    assert_eq!(get2(c, X), 0.0);
+    assert!(get2(c, X).abs() < 1e-300, "at rest at the start");
     assert_eq!(set2(c, F, 10.0), 0);
     let h = 0.01;
     let mut worst = 0.0_f64;
@@ -334,7 +335,7 @@ fn fmi2_parameters_before_the_start_and_saved_states() {
         t += 0.5;
     }
     assert!((get2(c, X) - 0.02).abs() < 1e-9, "x = {}", get2(c, X));
-    assert_eq!(get2(c, K), 400.0);
+    assert!((get2(c, K) - 400.0).abs() < 1e-12);
 
     // a saved state: back to t = 30 after going on, and the same future again
     let mut s: *mut c_void = ptr::null_mut();
@@ -347,7 +348,7 @@ fn fmi2_parameters_before_the_start_and_saved_states() {
     assert_eq!(unsafe { fmi2SetFMUstate(c, s) }, 0);
     assert!((get2(c, 0) - 30.0).abs() < 1e-12);
     assert!((get2(c, X) - 0.02).abs() < 1e-9);
-    assert_eq!(get2(c, F), 8.0);
+    assert!((get2(c, F) - 8.0).abs() < 1e-12);
     assert_eq!(set2(c, F, -8.0), 0);
     assert_eq!(step2(c, 30.0, 1.0), 0);
     assert!((get2(c, X) - x_on).abs() < 1e-8, "{} vs {x_on}", get2(c, X));
@@ -372,7 +373,7 @@ fn two_instances_are_independent() {
         assert_eq!(step2(b, t, 0.01), 0);
     }
     assert!((get2(a, X) - msd_x(10.0, 1.0)).abs() < 1e-8);
-    assert_eq!(get2(b, X), 0.0);
+    assert!(get2(b, X).abs() < 1e-300, "b untouched by a's input");
     // SAFETY: live instances, freed once.
     unsafe {
         fmi2FreeInstance(a);
