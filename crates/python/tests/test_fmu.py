@@ -199,3 +199,16 @@ def test_two_instances_in_one_process_are_independent(tmp_path):
         s.terminate()
         s.freeInstance()
     shutil.rmtree(unzipdir, ignore_errors=True)
+
+
+def test_the_snippet_of_docs_fmu_md_runs(tmp_path, monkeypatch):
+    text = (ROOT / "docs" / "fmu.md").read_text()
+    blocks = text.split("```python\n")[1:]
+    assert len(blocks) == 1, "docs/fmu.md has one Python snippet"
+    code = blocks[0].split("```")[0]
+    export("models/msd_force.toml", tmp_path / "msd_force.fmu")
+    monkeypatch.chdir(tmp_path)
+    ns = {}
+    exec(compile(code, "docs/fmu.md", "exec"), ns)
+    # the 10 N step ends at the static deflection F/k = 0.1 m, whatever the damper
+    assert abs(ns["result"]["x"][-1] - 0.1) < 1e-4
