@@ -99,6 +99,9 @@ pub struct Instance {
     run: Option<Stepping>,
     /// The probes of the output variables (by value reference; `None` for the others).
     probes: Vec<Option<Probe>>,
+    /// The outputs at the current time and state, evaluated once for all of them (by value
+    /// reference); empty when stale (after a step, an input set, a state set).
+    outputs: Vec<f64>,
     /// Current values of inputs and parameters (by value reference).
     values: Vec<f64>,
     inputs_set: Vec<bool>,
@@ -202,6 +205,7 @@ impl Instance {
             model: Some(model),
             run: None,
             probes: Vec::new(),
+            outputs: Vec::new(),
             values,
             inputs_set: vec![false; n_inputs],
             params_set: false,
@@ -298,6 +302,7 @@ impl Instance {
             }
         }
         self.probes = probes;
+        self.outputs.clear();
         self.run = Some(run);
         Ok(())
     }
@@ -345,12 +350,29 @@ impl Instance {
             Role::Input(_) | Role::Parameter(_) => Ok(self.values[vr as usize]),
             Role::Output(_) => {
                 self.running()?;
-                match (self.probes.get(vr as usize).copied().flatten(), &self.run) {
-                    (Some(p), Some(r)) => Ok(r.read(p)),
-                    _ => Err(Failure::error(format!("output {vr} is not readable"))),
+                if self.outputs.is_empty() {
+                    self.evaluate_outputs();
                 }
+                self.outputs
+                    .get(vr as usize)
+                    .copied()
+                    .ok_or_else(|| Failure::error(format!("output {vr} is not readable")))
             }
         }
+    }
+
+    /// Every output at the current time and state: one evaluation of the equations for
+    /// all of them (reading them one by one would evaluate the equations each time).
+    fn evaluate_outputs(&mut self) {
+        let Some(run) = &self.run else { return };
+        let sim = run.simulation();
+        let (t, x, eqs) = (sim.t(), sim.state(), sim.equations());
+        eqs.evaluate(t, x);
+        self.outputs = self
+            .probes
+            .iter()
+            .map(|p| p.map_or(f64::NAN, |p| eqs.read(p, t, x)))
+            .collect();
     }
 
     /// Set variable `vr` to `value`: an input (from now on), a parameter (before the run
@@ -387,6 +409,7 @@ impl Instance {
                 if let Some(run) = self.run.as_mut() {
                     let input = run.input_names().get(i).cloned().unwrap_or(name);
                     run.set_input(&input, value)?;
+                    self.outputs.clear();
                 }
                 Ok(())
             }
@@ -428,6 +451,7 @@ impl Instance {
             )));
         }
         let file = self.file.clone();
+        self.outputs.clear();
         let run = self.running()?;
         let now = run.t();
         if (t - now).abs() > 1e-9 * now.abs().max(1.0) {
@@ -435,7 +459,8 @@ impl Instance {
                 "{file}: step from t = {t}, but the instance is at t = {now}\n  hint: the communication point must be where the last step ended"
             )));
         }
-        if let Err(e) = run.advance_to(now + h) {
+        // to the importer's next communication point (its grid, not ours, defines time)
+        if let Err(e) = run.advance_to((t + h).max(now)) {
             self.failed = true;
             return Err(e.into());
         }
