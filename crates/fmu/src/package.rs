@@ -17,15 +17,17 @@ use crate::instance::{registry, MANIFEST};
 pub enum ExportError {
     /// The model does not load.
     Model(Box<ModelError>),
-    /// A file could not be read or written, or the model names a file the FMU cannot carry.
+    /// A file the model names (or the engine library) is missing, unreadable or absolute.
     File(String),
+    /// The FMU could not be written.
+    Output(String),
 }
 
 impl std::fmt::Display for ExportError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             Self::Model(e) => write!(f, "{e}"),
-            Self::File(m) => f.write_str(m),
+            Self::File(m) | Self::Output(m) => f.write_str(m),
         }
     }
 }
@@ -158,7 +160,7 @@ pub fn export(
         ))
     })?;
     let o = std::fs::File::create(out)
-        .map_err(|e| ExportError::File(format!("{}: cannot write: {e}", out.display())))?;
+        .map_err(|e| ExportError::Output(format!("{}: cannot write: {e}", out.display())))?;
     let mut zip = zip::ZipWriter::new(o);
     let deflate = SimpleFileOptions::default()
         .compression_method(zip::CompressionMethod::Deflated)
@@ -166,7 +168,7 @@ pub fn export(
     let mut entries: Vec<String> = Vec::new();
     let mut write = |name: &str, bytes: &[u8], mode: u32| -> Result<(), ExportError> {
         let werr = |e: &dyn std::fmt::Display| {
-            ExportError::File(format!("{}: cannot write `{name}`: {e}", out.display()))
+            ExportError::Output(format!("{}: cannot write `{name}`: {e}", out.display()))
         };
         zip.start_file(name, deflate.unix_permissions(mode))
             .map_err(|e| werr(&e))?;
@@ -217,7 +219,7 @@ pub fn export(
         add(format!("resources/{}", slash(&rel(f))), &bytes, 0o644)?;
     }
     zip.finish()
-        .map_err(|e| ExportError::File(format!("{}: cannot write: {e}", out.display())))?;
+        .map_err(|e| ExportError::Output(format!("{}: cannot write: {e}", out.display())))?;
     Ok(Exported {
         description,
         model_identifier: id,

@@ -212,3 +212,24 @@ def test_the_snippet_of_docs_fmu_md_runs(tmp_path, monkeypatch):
     exec(compile(code, "docs/fmu.md", "exec"), ns)
     # the 10 N step ends at the static deflection F/k = 0.1 m, whatever the damper
     assert abs(ns["result"]["x"][-1] - 0.1) < 1e-4
+
+
+def test_bad_input_to_bg_sim_fmu_exits_2_with_file_line_and_hint(tmp_path):
+    def fmu(*args):
+        return subprocess.run([str(BG_SIM), "fmu", *args], capture_output=True, text=True)
+
+    broken = tmp_path / "broken.toml"
+    broken.write_text(
+        (ROOT / "models" / "msd_force.toml").read_text().replace('kind = "C", k = "k"', 'kind = "Cx", k = "k"')
+    )
+    r = fmu(str(broken), "-o", str(tmp_path / "b.fmu"))
+    assert r.returncode == 2
+    assert "broken.toml:28:" in r.stderr and "hint:" in r.stderr
+    assert not (tmp_path / "b.fmu").exists()
+    model = str(ROOT / "models" / "msd_force.toml")
+    r = fmu(model, "-o", str(tmp_path / "x.fmu"), "--fmi", "4")
+    assert r.returncode == 2 and "--fmi 2 or --fmi 3" in r.stderr
+    r = fmu(model, "-o", str(tmp_path / "x.fmu"), "--library", str(tmp_path / "none.so"))
+    assert r.returncode == 2 and "cargo build -p bg-fmu" in r.stderr
+    r = fmu(model, "-o", str(tmp_path / "no" / "dir" / "x.fmu"))
+    assert r.returncode == 1 and "cannot write" in r.stderr

@@ -2,7 +2,7 @@
 //! `modelDescription.xml`, the engine library (`cargo build -p bg-fmu`), and the model with
 //! its data and tables in `resources/` (docs/fmu.md).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use bg_fmu::{ExportError, FmiVersion};
@@ -87,15 +87,11 @@ pub fn command(a: &Args) -> ExitCode {
         }
         Err(ExportError::File(m)) => {
             tell!("error: {m}");
-            // a file the model names is bad input; the output not writable is a failure
-            if Path::new(&a.output)
-                .parent()
-                .is_some_and(|p| !p.as_os_str().is_empty() && !p.is_dir())
-            {
-                ExitCode::from(FAILED)
-            } else {
-                ExitCode::from(BAD_INPUT)
-            }
+            ExitCode::from(BAD_INPUT)
+        }
+        Err(ExportError::Output(m)) => {
+            tell!("error: {m}");
+            ExitCode::from(FAILED)
         }
     }
 }
