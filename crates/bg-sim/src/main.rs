@@ -13,7 +13,8 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use commands::{
-    bench, check, compare, energy, graph, kinds, linearize, modes, plot, reduce, run, sweep, FAILED,
+    bench, check, compare, energy, fmu, graph, kinds, linearize, modes, plot, reduce, run, sweep,
+    FAILED,
 };
 
 #[derive(Parser)]
@@ -70,6 +71,9 @@ enum Command {
     /// Draw a model's `[[plot]]` figures from a results CSV (--model), or a quick look at
     /// some of its columns, one panel each (--columns), as PNG and/or SVG.
     Plot(plot::Args),
+    /// Export the model as an FMI 2.0 (or --fmi 3) co-simulation FMU: the model and its data
+    /// in resources/, the engine library (`cargo build -p bg-fmu`) in binaries/ (docs/fmu.md).
+    Fmu(fmu::Args),
 }
 
 fn main() -> ExitCode {
@@ -115,5 +119,6 @@ fn dispatch(command: Command) -> ExitCode {
         Command::Reduce(a) => reduce::command(a),
         Command::Compare(a) => compare::command(&a),
         Command::Plot(a) => plot::command(&a),
+        Command::Fmu(a) => fmu::command(&a),
     }
 }
