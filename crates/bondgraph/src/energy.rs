@@ -488,6 +488,48 @@ mod tests {
     use super::*;
     use crate::simulate::{simulate_audited, Settings};
 
+    /// The default roles follow the causal rules, and the basic elements get the ones the
+    /// module's table says.
+    #[test]
+    fn roles_by_rule_and_by_element() {
+        use crate::bond::PortCausality::{EffortOut, FlowOut};
+        use crate::element::Element;
+        assert_eq!(
+            EnergyRole::from_rule(&CausalRule::Integral(vec![EffortOut])),
+            EnergyRole::Storage
+        );
+        assert_eq!(
+            EnergyRole::from_rule(&CausalRule::Resistive(vec![])),
+            EnergyRole::Dissipation
+        );
+        assert_eq!(
+            EnergyRole::from_rule(&CausalRule::Fixed(vec![EffortOut])),
+            EnergyRole::Source
+        );
+        assert_eq!(
+            EnergyRole::from_rule(&CausalRule::Fixed(vec![FlowOut, EffortOut])),
+            EnergyRole::Conservative
+        );
+        assert_eq!(
+            EnergyRole::from_rule(&CausalRule::AllEqual),
+            EnergyRole::Conservative
+        );
+        assert_eq!(EnergyRole::from_rule(&CausalRule::None), EnergyRole::Signal);
+        assert_eq!(crate::OneJunction.energy_role(3), EnergyRole::Conservative);
+        assert_eq!(
+            crate::Resistor::new(1.0).unwrap().energy_role(1),
+            EnergyRole::Dissipation
+        );
+        assert_eq!(
+            crate::Capacitor::new(1.0, 0.0).unwrap().energy_role(1),
+            EnergyRole::Storage
+        );
+        assert_eq!(
+            crate::EffortSource::new(1.0).energy_role(1),
+            EnergyRole::Source
+        );
+    }
+
     /// Mass–spring–damper with no source: what the damper dissipates is what the spring and
     /// the mass lose, E(0) − E(end), to 1e-8 relative.
     #[test]
