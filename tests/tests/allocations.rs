@@ -79,6 +79,7 @@ fn check(name: &str) {
 #[test]
 fn nothing_allocates_in_the_solver_loop() {
     rhs_and_jacobian_do_not_allocate();
+    energy_audit_steps_do_not_allocate();
     radau_steps_do_not_allocate();
     sparse_newton_iterations_do_not_allocate();
 }
@@ -130,6 +131,40 @@ fn rhs_and_jacobian_do_not_allocate() {
     assert_eq!(jac, (0, 0), "knuckle_boom with stiffening: Jacobian");
     for must in ["mass_spring_damper", "cylinder_lift", "knuckle_boom"] {
         assert!(checked.iter().any(|c| c == must), "{must} not checked");
+    }
+}
+
+/// The energy audit's work after an accepted step (three evaluations of the plan, the power
+/// of every element, the drives' external power) allocates nothing (docs/energy.md).
+fn energy_audit_steps_do_not_allocate() {
+    for name in [
+        "knuckle_boom",
+        "lift_circuit",
+        "ls_circuit",
+        "accumulator_circuit",
+    ] {
+        let model = bg_tests::load(name, &[]).unwrap();
+        let eqs = &model.equations;
+        let x0 = eqs.initial_state();
+        let mut audit = bondgraph::EnergyAudit::new(eqs);
+        audit.begin_segment(eqs, 0.0, &x0);
+        let dense = |_: f64, y: &mut [f64]| {
+            y.copy_from_slice(&x0);
+            Ok(())
+        };
+        audit.step(eqs, 0.0, 1e-3, &x0, dense).unwrap();
+        let mut best = usize::MAX;
+        for _ in 0..3 {
+            let region = Region::new(GLOBAL);
+            for k in 1..50 {
+                let t = 1e-3 * f64::from(k);
+                audit.step(eqs, t, t + 1e-3, &x0, dense).unwrap();
+            }
+            let c = region.change();
+            best = best.min(c.allocations + c.reallocations);
+        }
+        assert_eq!(best, 0, "{name}: allocations in 49 audited steps");
+        assert_eq!(audit.report(eqs).steps, 50 * 3 - 2);
     }
 }
 

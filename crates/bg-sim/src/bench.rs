@@ -310,9 +310,26 @@ fn interpolate(t: &[f64], v: &[f64], x: f64) -> f64 {
 }
 
 fn run_once(model: &mut Model, method: Method, rtol: f64) -> Result<Outcome, String> {
+    run_maybe_audited(model, method, rtol, false)
+}
+
+/// One run, with the energy audit (`bg-sim bench --energy`: its cost) or without.
+fn run_maybe_audited(
+    model: &mut Model,
+    method: Method,
+    rtol: f64,
+    energy: bool,
+) -> Result<Outcome, String> {
     model.settings.method = method;
     model.settings.rtol = rtol;
-    model.run().map_err(|e| e.to_string())
+    if energy {
+        model
+            .run_audited()
+            .map(|(o, _)| o)
+            .map_err(|e| e.to_string())
+    } else {
+        model.run().map_err(|e| e.to_string())
+    }
 }
 
 /// Measure `methods` × `rtols` against `reference`, each timed as the median of `repeat`
@@ -324,13 +341,26 @@ pub fn bench(
     reference: &Reference,
     repeat: usize,
 ) -> Result<Vec<BenchRow>, String> {
+    bench_audited(model, methods, rtols, reference, repeat, false)
+}
+
+/// [`bench`], each run with the energy audit when `energy` (`bg-sim bench --energy`: the
+/// audit's cost, side by side with a run without it).
+pub fn bench_audited(
+    model: &mut Model,
+    methods: &[Method],
+    rtols: &[f64],
+    reference: &Reference,
+    repeat: usize,
+    energy: bool,
+) -> Result<Vec<BenchRow>, String> {
     let mut rows = Vec::new();
     for &method in methods {
         for &rtol in rtols {
             let mut walls = Vec::new();
             let mut last = None;
             for _ in 0..repeat.max(1) {
-                let out = run_once(model, method, rtol)?;
+                let out = run_maybe_audited(model, method, rtol, energy)?;
                 walls.push(out.stats.wall_time);
                 let failed = out.error.is_some();
                 last = Some(out);

@@ -296,6 +296,15 @@ pub trait Element: Debug {
         crate::energy::EnergyRole::from_rule(&self.causal_rule(n_ports))
     }
 
+    /// Power the element takes from outside the graph, not through a port (a pump driven at
+    /// a set speed: its drive's T·ω), once every variable is known; `None` (the default):
+    /// everything it exchanges passes its ports. The energy audit counts it as supplied and
+    /// the difference from the power leaving its ports as the element's own losses.
+    fn external_power(&self, io: &Io<'_>) -> Option<f64> {
+        let _ = io;
+        None
+    }
+
     /// The external input this element is, if it is one ([`Input`](crate::Input): its signal
     /// is published under the element's bare name and set from outside the model).
     fn as_input(&self) -> Option<&crate::elements::Input> {

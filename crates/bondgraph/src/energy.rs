@@ -7,7 +7,7 @@
 //!
 //! | role | what its ∫P_i dt is | examples |
 //! |---|---|---|
-//! | [`EnergyRole::Source`] | −supplied | Se, Sf, a pump driven at its outlet, the crane's valve (from its supply), gravity |
+//! | [`EnergyRole::Source`] | −supplied (a source driven from outside the graph, [`Element::external_power`](crate::Element::external_power): supplied = ∫P_ext dt, its own losses ∫(P_ext + P) dt) | Se, Sf, a pump driven at its outlet, the crane's valve (from its supply), gravity |
 //! | [`EnergyRole::Storage`] | stored (E(end) − E(start) from [`Element::stored_energy`](crate::Element::stored_energy) where the element has one) | C, I, the arm's I- and C-fields, chambers, accumulators, lines |
 //! | [`EnergyRole::LossyStorage`] | stored = E(end) − E(start), dissipated = ∫P dt − stored | a line of C–R–I segments |
 //! | [`EnergyRole::Dissipation`] | dissipated | R, orifices, valves, leakage, friction, a machine's losses, modal damping |
@@ -250,6 +250,10 @@ struct Entry {
     /// Its states' range in the state vector.
     states: std::ops::Range<usize>,
     has_function: bool,
+    /// It takes power from outside the graph ([`Element::external_power`](crate::Element::external_power)).
+    has_external: bool,
+    /// ∫ external power dt.
+    external: f64,
     net: f64,
     activity: f64,
     through: f64,
@@ -278,6 +282,8 @@ impl EnergyAudit {
     pub fn new(eqs: &StateEquations) -> Self {
         let g = eqs.graph();
         let mut entries = Vec::new();
+        let x0 = eqs.initial_state();
+        let t0 = 0.0;
         for id in 0..g.n_elements() {
             let el = &g.node(id).element;
             let n_ports = g.ports_of(id).len();
@@ -288,7 +294,8 @@ impl EnergyAudit {
             let n = eqs.states().iter().filter(|s| s.element == id).count();
             let first = eqs.state_index(id, 0).unwrap_or(0);
             let states = first..first + n;
-            let x0 = eqs.initial_state();
+            // whether it has one (the value, of whatever the workspace holds, is not used)
+            let has_external = eqs.external_power(id, t0, &x0).is_some();
             let has_function = matches!(role, EnergyRole::Storage | EnergyRole::LossyStorage)
                 && el.stored_energy(&x0[states.clone()]).is_some();
             entries.push(Entry {
@@ -296,6 +303,8 @@ impl EnergyAudit {
                 role,
                 states,
                 has_function,
+                has_external,
+                external: 0.0,
                 net: 0.0,
                 activity: 0.0,
                 through: 0.0,
@@ -354,6 +363,9 @@ impl EnergyAudit {
         eqs.evaluate(t, &self.y);
         for e in &mut self.entries {
             let p = eqs.power_into(e.id);
+            if e.has_external {
+                e.external += weight * eqs.external_power(e.id, t, &self.y).unwrap_or(0.0);
+            }
             e.net += weight * p;
             e.activity += weight * p.abs();
             e.through += weight * eqs.power_scale(e.id);
@@ -413,6 +425,11 @@ impl EnergyAudit {
             let node = g.node(e.id);
             let (mut supplied, mut stored, mut dissipated) = (0.0, 0.0, 0.0);
             match e.role {
+                EnergyRole::Source if e.has_external => {
+                    // the drive's energy; what did not leave through the ports was lost inside
+                    supplied = e.external;
+                    dissipated = e.external + e.net;
+                }
                 EnergyRole::Source => supplied = -e.net,
                 EnergyRole::Storage => {
                     stored = if e.has_function { e.stored } else { e.net };
@@ -470,6 +487,48 @@ impl EnergyAudit {
 mod tests {
     use super::*;
     use crate::simulate::{simulate_audited, Settings};
+
+    /// The default roles follow the causal rules, and the basic elements get the ones the
+    /// module's table says.
+    #[test]
+    fn roles_by_rule_and_by_element() {
+        use crate::bond::PortCausality::{EffortOut, FlowOut};
+        use crate::element::Element;
+        assert_eq!(
+            EnergyRole::from_rule(&CausalRule::Integral(vec![EffortOut])),
+            EnergyRole::Storage
+        );
+        assert_eq!(
+            EnergyRole::from_rule(&CausalRule::Resistive(vec![])),
+            EnergyRole::Dissipation
+        );
+        assert_eq!(
+            EnergyRole::from_rule(&CausalRule::Fixed(vec![EffortOut])),
+            EnergyRole::Source
+        );
+        assert_eq!(
+            EnergyRole::from_rule(&CausalRule::Fixed(vec![FlowOut, EffortOut])),
+            EnergyRole::Conservative
+        );
+        assert_eq!(
+            EnergyRole::from_rule(&CausalRule::AllEqual),
+            EnergyRole::Conservative
+        );
+        assert_eq!(EnergyRole::from_rule(&CausalRule::None), EnergyRole::Signal);
+        assert_eq!(crate::OneJunction.energy_role(3), EnergyRole::Conservative);
+        assert_eq!(
+            crate::Resistor::new(1.0).unwrap().energy_role(1),
+            EnergyRole::Dissipation
+        );
+        assert_eq!(
+            crate::Capacitor::new(1.0, 0.0).unwrap().energy_role(1),
+            EnergyRole::Storage
+        );
+        assert_eq!(
+            crate::EffortSource::new(1.0).energy_role(1),
+            EnergyRole::Source
+        );
+    }
 
     /// Mass–spring–damper with no source: what the damper dissipates is what the spring and
     /// the mass lose, E(0) − E(end), to 1e-8 relative.

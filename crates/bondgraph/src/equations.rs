@@ -731,6 +731,28 @@ impl StateEquations {
             .sum()
     }
 
+    /// [`Element::external_power`] of element `id` after [`evaluate`](Self::evaluate) at
+    /// (t, x).
+    #[must_use]
+    pub fn external_power(&self, id: ElementId, t: f64, x: &[f64]) -> Option<f64> {
+        let mut ws = self.ws.borrow_mut();
+        let Workspace {
+            effort,
+            flow,
+            signals,
+            ..
+        } = &mut *ws;
+        let io = Io {
+            t,
+            x,
+            effort,
+            flow,
+            signals,
+            layout: &self.layouts[id],
+        };
+        self.graph.node(id).element.external_power(&io)
+    }
+
     /// Largest |e·f| on the ports of element `id`, the scale for [`power_into`](Self::power_into).
     #[must_use]
     pub fn power_scale(&self, id: ElementId) -> f64 {

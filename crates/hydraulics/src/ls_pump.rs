@@ -219,6 +219,16 @@ impl Element for LsPump {
             bondgraph::EnergyRole::Source
         }
     }
+    fn external_power(&self, io: &Io<'_>) -> Option<f64> {
+        // Driven at a set speed: the drive's power T·ω.
+        if self.has_shaft() {
+            return None;
+        }
+        let d = self.d_max * io.states()[0];
+        let omega = self.omega(io);
+        let delta = io.e(PA, 0) - io.e(PB, 0);
+        Some(self.machine.torque(d, omega, delta) * omega)
+    }
     fn ports(&self) -> Ports {
         let mut p = vec![
             PortSpec::new("a", 1),

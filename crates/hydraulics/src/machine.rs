@@ -225,6 +225,16 @@ impl Element for Machine {
             bondgraph::EnergyRole::Source
         }
     }
+    fn external_power(&self, io: &Io<'_>) -> Option<f64> {
+        // Driven at a set speed: the drive's power r·T·ω (T in the role's convention).
+        if self.has_shaft() {
+            return None;
+        }
+        let d = self.d_max * self.epsilon(io).0;
+        let omega = self.omega(io);
+        let delta = io.e(0, 0) - io.e(1, 0);
+        Some(self.r() * self.torque(d, omega, delta) * omega)
+    }
     fn ports(&self) -> Ports {
         let mut p = vec![PortSpec::new("a", 1), PortSpec::new("b", 1)];
         if self.has_shaft() {

@@ -115,7 +115,7 @@ type RunResult<'py> = (
 
 /// Run a model: (columns, row-major f64 values as bytes, statistics, error or None).
 #[pyfunction]
-#[pyo3(signature = (path, set, t_end=None, rtol=None, atol=None, dt_out=None, solver=None, inputs=Vec::new(), extrapolate=false))]
+#[pyo3(signature = (path, set, t_end=None, rtol=None, atol=None, dt_out=None, solver=None, inputs=Vec::new(), extrapolate=false, energy=false))]
 #[allow(clippy::too_many_arguments)]
 fn run<'py>(
     py: Python<'py>,
@@ -128,6 +128,7 @@ fn run<'py>(
     solver: Option<String>,
     inputs: Vec<stepping::InputData>,
     extrapolate: bool,
+    energy: bool,
 ) -> PyResult<RunResult<'py>> {
     let all = settings(&set, t_end, rtol, atol, dt_out, solver.as_deref());
     // the GIL is released while the model runs: other Python threads go on
@@ -135,7 +136,19 @@ fn run<'py>(
         let mut m = Model::load(&path, &bg_sim::registry(), &all).map_err(Ok)?;
         let span = Some((m.settings.t_start, m.settings.t_end));
         stepping::set_series(&mut m, inputs, span, extrapolate).map_err(Err)?;
-        let (out, checks) = m.run_checked().map_err(Ok)?;
+        // with `energy`, the audit as the JSON of `bg-sim energy --format json`: by
+        // composite, and every element
+        let (out, checks, audit) = if energy {
+            let run = m.run_energy_checked().map_err(Ok)?;
+            let tables = (
+                bg_sim::energy::json(&run.report, false).to_string(),
+                bg_sim::energy::json(&run.report, true).to_string(),
+            );
+            (run.outcome, run.checks, Some(tables))
+        } else {
+            let (out, checks) = m.run_checked().map_err(Ok)?;
+            (out, checks, None)
+        };
         let failed: Vec<String> = checks
             .iter()
             .filter(|c| !c.passed)
@@ -146,9 +159,9 @@ fn run<'py>(
                 )
             })
             .collect();
-        Ok((out, failed))
+        Ok((out, failed, audit))
     });
-    let (out, failed) = result.map_err(|e| match e {
+    let (out, failed, audit) = result.map_err(|e| match e {
         Ok(e) => model_error(py, &e),
         Err(message) => other_error(message),
     })?;
@@ -169,6 +182,10 @@ fn run<'py>(
     stats.set_item("wall_s", s.wall_time.as_secs_f64())?;
     stats.set_item("t_final", out.t_final)?;
     stats.set_item("failed_checks", failed)?;
+    if let Some((grouped, expanded)) = audit {
+        stats.set_item("energy", grouped)?;
+        stats.set_item("energy_expanded", expanded)?;
+    }
     let error = out
         .error
         .as_ref()

@@ -128,3 +128,39 @@ def test_a_run_that_stops_early_raises_with_its_partial_rows():
     partial = e.value.partial
     assert 4.0 < partial["t"].iloc[-1] < 6.0
     assert isinstance(e.value, bgsim.BgSimError)
+
+
+def test_run_energy_is_the_audit_as_a_dataframe():
+    # docs/energy.md: no source, so what the damper dissipates is what the spring and the
+    # mass lost
+    df = bgsim.load(MSD, set={"simulation.solver": "radau5"}).run(energy=True)
+    e = df.energy()
+    assert set(e.index) == {"spring", "mass", "damper"}
+    assert set(e.columns) >= {"kind", "role", "supplied", "stored", "dissipated", "activity", "share"}
+    lost = -(e.loc["spring", "stored"] + e.loc["mass", "stored"])
+    assert e.loc["damper", "dissipated"] == pytest.approx(lost, rel=1e-8)
+    assert e.loc["damper", "role"] == "dissipation"
+    assert e["share"].sum() == pytest.approx(1.0, abs=1e-12)
+    totals = df.energy_totals()
+    assert totals["relative_residual"] < 1e-8
+    assert totals["stored_initial"] == pytest.approx(0.5 * 10.0 * 0.01**2, rel=1e-12)
+    # every element, the junction too
+    assert "v" in df.energy(expand=True).index
+    # a run that was not audited says so
+    with pytest.raises(bgsim.BgSimError, match="energy=True"):
+        bgsim.load(MSD).run(t_end=0.1).energy()
+
+
+def test_a_sweep_metric_can_be_an_energy():
+    # more damping, more of the initial ½k·x0² dissipated by t_end
+    rows = [
+        bgsim._run_one(str(MSD), {"c": c}, {"loss": "energy.damper.dissipated", "x_max": "max(x)"}, i)
+        for i, c in enumerate([0.2, 2.0])
+    ]
+    assert [r["status"] for r in rows] == ["ok", "ok"]
+    e0 = 0.5 * 10.0 * 0.01**2
+    assert 0.0 < rows[0]["loss"] < rows[1]["loss"] <= e0 * (1 + 1e-6)
+    bad = bgsim._run_one(str(MSD), {}, {"loss": "energy.nobody.dissipated"}, 0)
+    assert bad["status"] == "error" and "nobody" in bad["error"]
+    with pytest.raises(bgsim.BgSimError, match="energy metric"):
+        bgsim._run_one(str(MSD), {}, {"loss": "energy.damper.heat"}, 0)

@@ -52,6 +52,10 @@ pub struct Args {
     /// Override a value of the model file (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
+    /// Run every configuration with the energy audit too (docs/energy.md): its rows follow,
+    /// marked `+energy`, to read the audit's cost side by side.
+    #[arg(long)]
+    pub energy: bool,
 }
 
 /// `bg-sim bench`.
@@ -69,6 +73,7 @@ pub fn command(a: Args) -> ExitCode {
         repeat,
         t_end,
         set,
+        energy,
     } = a;
     bench(&BenchArgs {
         path: &model,
@@ -83,6 +88,7 @@ pub fn command(a: Args) -> ExitCode {
         repeat,
         t_end,
         set: &set,
+        energy,
     })
 }
 
@@ -99,10 +105,11 @@ struct BenchArgs<'a> {
     repeat: usize,
     t_end: Option<f64>,
     set: &'a [String],
+    energy: bool,
 }
 
 fn bench(a: &BenchArgs<'_>) -> ExitCode {
-    use bg_sim::bench::{bench, reference_run, rhs_cost, table, Reference};
+    use bg_sim::bench::{bench, bench_audited, reference_run, rhs_cost, table, Reference};
     let mut model = match Model::load(a.path, &registry(), a.set) {
         Ok(m) => m,
         Err(e) => {
@@ -178,6 +185,18 @@ fn bench(a: &BenchArgs<'_>) -> ExitCode {
     match bench(&mut model, &methods, a.rtols, &reference, a.repeat) {
         Ok(rows) => {
             say!("{}", table(&rows).trim_end_matches('\n'));
+            if a.energy {
+                match bench_audited(&mut model, &methods, a.rtols, &reference, a.repeat, true) {
+                    Ok(audited) => {
+                        say!("with the energy audit (+energy):");
+                        say!("{}", table(&audited).trim_end_matches('\n'));
+                    }
+                    Err(e) => {
+                        tell!("error: {e}");
+                        return ExitCode::from(super::FAILED);
+                    }
+                }
+            }
             if let Some(png) = a.plot {
                 let lines: Vec<WorkPrecisionLine> = methods
                     .iter()

@@ -108,6 +108,8 @@ fn reduce(
         Reduction::Mean => Some(series.iter().map(|p| p.1).sum::<f64>() / n),
         Reduction::Rms => Some((series.iter().map(|p| p.1 * p.1).sum::<f64>() / n).sqrt()),
         Reduction::Initial => series.first().map(|p| p.1),
+        // read from the audit by `run_point`, never reduced from rows
+        Reduction::Energy => None,
         Reduction::Final => series.last().map(|p| p.1),
         Reduction::FirstCrossing => {
             let l = metric.level;
@@ -157,7 +159,16 @@ pub fn run_point(
         }
     };
     model.settings.interrupt = interrupt.cloned();
-    let result = model.run_checked();
+    let audited = metrics.iter().any(|m| m.reduction == Reduction::Energy);
+    let mut audit = None;
+    let result = if audited {
+        run_audited(&mut model).map(|(out, checks, report)| {
+            audit = Some(report);
+            (out, checks)
+        })
+    } else {
+        model.run_checked()
+    };
     row.wall_s = start.elapsed().as_secs_f64();
     let (out, checks) = match result {
         Ok(r) => r,
@@ -190,6 +201,23 @@ pub fn run_point(
         row.error = failed.join("; ");
     }
     for (slot, m) in row.metrics.iter_mut().zip(metrics) {
+        if m.reduction == Reduction::Energy {
+            match audit.as_ref().map(|a| (a.metric(&m.source), a)) {
+                Some((Some(v), _)) => *slot = Some(v),
+                Some((None, a)) => {
+                    row.status = Status::Error;
+                    row.error = format!(
+                        "metric `{}` = \"{}\": no element or composite of that name in the energy audit (they are: {})",
+                        m.name,
+                        m.source,
+                        a.by_composite().iter().map(|g| g.name.as_str()).collect::<Vec<_>>().join(", ")
+                    );
+                    break;
+                }
+                None => {}
+            }
+            continue;
+        }
         match reduce(m, columns, rows, &model.parameters) {
             Ok(v) => *slot = v,
             Err(e) => {
@@ -207,6 +235,17 @@ pub fn run_point(
         }
     }
     row
+}
+
+/// [`Model::run_checked`] with the energy audit (rows in memory, bounded alike).
+type Audited = (
+    bondgraph::Outcome,
+    Vec<bg_model::CheckResult>,
+    bondgraph::EnergyReport,
+);
+fn run_audited(model: &mut Model) -> Result<Audited, bg_model::ModelError> {
+    let run = model.run_energy_checked()?;
+    Ok((run.outcome, run.checks, run.report))
 }
 
 fn write_run(path: &Path, columns: &[String], rows: &[Vec<f64>]) -> std::io::Result<()> {

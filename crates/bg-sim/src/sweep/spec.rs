@@ -79,6 +79,11 @@ pub enum Reduction {
     TimeOfMin,
     /// First time the value crosses the level (interpolated); empty if it never does.
     FirstCrossing,
+    /// An entry of the run's energy audit, written bare: `energy.<element or
+    /// composite>.<supplied|stored|dissipated|net|activity|share>` or a total
+    /// `energy.<supplied|stored|dissipated|residual|relative_residual>` (docs/energy.md);
+    /// the run is then audited.
+    Energy,
 }
 
 const REDUCTIONS: &[(&str, Reduction)] = &[
@@ -398,6 +403,42 @@ pub fn parse_metric(name: &str, src: &str) -> Result<Metric, String> {
         )
     };
     let s = src.trim();
+    if let Some(rest) = s.strip_prefix("energy.").filter(|_| !s.contains('(')) {
+        const FIELDS: &[&str] = &[
+            "supplied",
+            "stored",
+            "dissipated",
+            "net",
+            "activity",
+            "share",
+        ];
+        const TOTALS: &[&str] = &[
+            "supplied",
+            "stored",
+            "dissipated",
+            "residual",
+            "relative_residual",
+        ];
+        let ok = match rest.rsplit_once('.') {
+            Some((who, field)) => !who.is_empty() && FIELDS.contains(&field),
+            None => TOTALS.contains(&rest),
+        };
+        if !ok {
+            return Err(format!(
+                "metric `{name}` = \"{}\": an energy metric is energy.<element or composite>.<{}> or energy.<{}>",
+                bg_model::error::clip(src),
+                FIELDS.join("|"),
+                TOTALS.join("|")
+            ));
+        }
+        return Ok(Metric {
+            name: name.to_owned(),
+            reduction: Reduction::Energy,
+            expr: Expr::parse("0").map_err(|e| e.to_string())?,
+            level: 0.0,
+            source: s.to_owned(),
+        });
+    }
     let (head, rest) = s.split_once('(').ok_or_else(|| bad("no `(`"))?;
     let inner = rest
         .strip_suffix(')')

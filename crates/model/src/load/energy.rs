@@ -54,6 +54,41 @@ impl Model {
         })
     }
 
+    /// [`Model::run`] (rows in memory, no checks) with the energy audit: what `bg-sim bench
+    /// --energy` times against [`Model::run`].
+    pub fn run_audited(&mut self) -> Result<(bondgraph::Outcome, EnergyReport), ModelError> {
+        let mut audit = EnergyAudit::new(&self.equations);
+        let mut rows: Vec<Vec<f64>> = Vec::new();
+        let mut out = self.run_events(|eqs, x0, s, outputs, events| {
+            bondgraph::simulate_audited(eqs, x0, s, outputs, events, &mut rows, Some(&mut audit))
+        })?;
+        out.trajectory.rows = rows;
+        let mut report = audit.report(&self.equations);
+        for e in &mut report.elements {
+            e.composite = self.entry_of(&e.name);
+        }
+        Ok((out, report))
+    }
+
+    /// [`Model::run_energy`] keeping the rows in memory (in `outcome.trajectory.rows`),
+    /// bounded as [`Model::run_checked`].
+    pub fn run_energy_checked(&mut self) -> Result<EnergyRun, ModelError> {
+        bondgraph::check_in_memory(&self.settings, self.outputs.len() + 1).map_err(|e| {
+            self.source
+                .err(
+                    crate::error::ErrorKind::Settings,
+                    None,
+                    format!("[simulation] {}", e.message()),
+                )
+                .or_hint(e.hint())
+                .with_source(e)
+        })?;
+        let mut rows: Vec<Vec<f64>> = Vec::new();
+        let mut run = self.run_energy(&mut rows)?;
+        run.outcome.trajectory.rows = rows;
+        Ok(run)
+    }
+
     /// [`Model::run_energy`] keeping no rows.
     pub fn energy(&mut self) -> Result<EnergyRun, ModelError> {
         self.run_energy(&mut Discard)

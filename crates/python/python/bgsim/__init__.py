@@ -17,6 +17,7 @@ built anew by each run, so a :class:`Model` pickles and runs on Dask workers
 
 from __future__ import annotations
 
+import json
 import os
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Union
 
@@ -30,6 +31,7 @@ __all__ = [
     "BgSimError",
     "LinearModel",
     "Model",
+    "Results",
     "RunError",
     "Simulation",
     "load",
@@ -266,9 +268,14 @@ class Model:
         inputs: Optional[InputData] = None,
         inputs_interp: str = "linear",
         extrapolate: Optional[str] = None,
-    ) -> Union[pd.DataFrame, Dict[str, np.ndarray]]:
-        """Run the model and return its rows: a DataFrame (``t`` and the ``[outputs]``), or
-        with ``as_dict=True`` a dict of numpy arrays.
+        energy: bool = False,
+    ) -> Union["Results", Dict[str, np.ndarray]]:
+        """Run the model and return its rows: a DataFrame (``t`` and the ``[outputs]``, a
+        :class:`Results`), or with ``as_dict=True`` a dict of numpy arrays.
+
+        With ``energy=True`` the run is audited (docs/energy.md): ``run(...).energy()`` is
+        the table of ``bg-sim energy`` as a DataFrame (``energy(expand=True)``: every
+        element), and ``.energy_totals()`` its totals, balance and efficiency.
 
         Settings not given are the file's. ``inputs`` drives the model's inputs with data:
         a DataFrame with a ``t`` column and one column per input (any subset; the others
@@ -293,11 +300,16 @@ class Model:
             solver,
             _input_data(inputs, inputs_interp),
             extrapolate == "hold",
+            energy,
         )
         values = np.frombuffer(data, dtype=np.float64).reshape(-1, len(columns))
         if as_dict and error is None:
             return {c: values[:, j].copy() for j, c in enumerate(columns)}
-        df = pd.DataFrame(values.copy(), columns=columns)
+        df = Results(values.copy(), columns=columns)
+        stats = dict(stats)
+        for key in ("energy", "energy_expanded"):
+            if key in stats:
+                df.attrs[key] = json.loads(stats.pop(key))
         df.attrs["stats"] = stats
         if error is not None:
             raise RunError(f"{self.path}: {error}", df, stats)
@@ -340,6 +352,44 @@ class Model:
             list(outputs),
         )
         return LinearModel(d)
+
+
+class Results(pd.DataFrame):
+    """A run's rows (``t`` and the ``[outputs]``): a pandas DataFrame, with the run's energy
+    audit when it was run with ``energy=True``."""
+
+    @property
+    def _constructor(self):
+        return Results
+
+    def _audit(self, expand: bool) -> Dict[str, Any]:
+        key = "energy_expanded" if expand else "energy"
+        if key not in self.attrs:
+            raise BgSimError("this run was not audited: run it with energy=True")
+        return self.attrs[key]
+
+    def energy(self, expand: bool = False) -> pd.DataFrame:
+        """The energy audit as a DataFrame, one row per composite (``expand=True``: per
+        element, junctions and transformers included), indexed by name, largest activity
+        first: kind, composite, role, supplied, stored, dissipated, net, activity (J) and
+        share (of the total activity), as ``bg-sim energy --format json``."""
+        rows = self._audit(expand)["rows"]
+        cols = ["name", "kind", "composite", "role", "supplied", "stored", "dissipated",
+                "net", "activity", "share", "stored_by_function"]
+        return pd.DataFrame(rows, columns=cols).set_index("name")
+
+    def energy_totals(self) -> Dict[str, Any]:
+        """The audit's totals (supplied, stored, dissipated, residual, relative_residual,
+        …), its efficiency (input, useful, losses, efficiency) and its span (t_start, t_end,
+        steps), as a dict."""
+        a = self._audit(False)
+        return {
+            **a["totals"],
+            "efficiency": dict(a["efficiency"]),
+            "t_start": a["t_start"],
+            "t_end": a["t_end"],
+            "steps": a["steps"],
+        }
 
 
 def load(path: PathLike, set: Optional[Mapping[str, Scalar]] = None) -> Model:

@@ -23,6 +23,9 @@ def run(
     atol: Optional[float] = None,
     dt_out: Optional[float] = None,
     solver: Optional[str] = None,
+    inputs: List[Any] = ...,
+    extrapolate: bool = False,
+    energy: bool = False,
 ) -> Tuple[List[str], bytes, Dict[str, Any], Optional[str]]: ...
 def run_one(
     path: str,
