@@ -80,9 +80,8 @@ pub struct StateEquations {
     n_bond_values: usize,
     signal_names: Vec<(String, usize, usize)>,
     ws: RefCell<Workspace>,
-    jac_plan: jacobian::JacobianPlan,
-    /// The Jacobian's buffers, allocated by its first call.
-    jac_work: RefCell<Option<jacobian::JacobianWork>>,
+    /// The Jacobian compiled for `rhs_order` and its buffers, made by its first call.
+    jac: RefCell<jacobian::JacobianState>,
     /// The external inputs ([`Input`](crate::Input) elements), in element order.
     inputs: Vec<ElementId>,
     /// Whether a run stops and restarts at the inputs' breakpoints (default: yes).
@@ -184,8 +183,7 @@ impl StateEquations {
             n_bond_values,
             signal_names,
             ws: RefCell::new(Workspace::default()),
-            jac_plan: jacobian::JacobianPlan::default(),
-            jac_work: RefCell::new(None),
+            jac: RefCell::new(jacobian::JacobianState::default()),
             inputs: Vec::new(),
             stop_at_breakpoints: true,
         };
@@ -194,7 +192,6 @@ impl StateEquations {
             .collect();
         eqs.resolve_inputs()?;
         eqs.plan()?;
-        eqs.jac_plan = eqs.jacobian_plan();
         *eqs.ws.borrow_mut() = Workspace {
             effort: vec![0.0; n_bond_values],
             flow: vec![0.0; n_bond_values],

@@ -154,7 +154,7 @@ impl LocalShape {
 }
 
 /// The partial derivatives of one stage of an element (or of its state derivatives) with
-/// respect to the element's local variables: a dense row-major block the element fills in
+/// respect to the element's local variables: a block the element fills in
 /// [`Element::stage_partials`] and
 /// [`Element::derivative_partials`].
 ///
@@ -176,8 +176,15 @@ impl LocalShape {
 /// [`flow_col`](Self::flow_col), [`input_col`](Self::input_col),
 /// [`state_col`](Self::state_col), [`row`](Self::row) (and
 /// [`derivative_row`](Self::derivative_row)), then [`set`](Self::set) / [`add`](Self::add).
-/// The block is a view into buffers sized once per element and stage when the plan is built:
-/// filling it never allocates.
+///
+/// **Storage.** A block of up to [`DENSE_MAX_COLS`] columns is dense, row-major. A wider one
+/// (a line of many segments, a manipulator field) is stored on its *structure*: the entries
+/// the element set when the core first asked (at the initial state), each row's columns
+/// sorted — so a line of N segments holds about 5N entries, not 4N². An element with such a
+/// block should set the same entries wherever it is asked (a zero is fine); an entry outside
+/// the structure is noted, and the core then widens the structure and assembles the
+/// Jacobian again. Either way the block is a view into buffers sized when the plan is
+/// compiled: filling it never allocates.
 ///
 /// A resistor in conductance causality, f_in = e / r, fills one entry:
 /// ```
@@ -190,20 +197,43 @@ impl LocalShape {
 pub struct LocalJacobian<'a> {
     shape: &'a LocalShape,
     values: &'a mut [f64],
+    index: Index<'a>,
     /// The entries set so far, when the core keeps a list of them (so that it reads, and
     /// zeroes again, only those).
     touched: Option<Touched<'a>>,
+    /// Whether an entry outside a sparse structure was set (and dropped).
+    outside: bool,
 }
 
-/// The list of entries a [`LocalJacobian`] has set, as (row, column), and a mark per entry.
+/// Blocks with up to this many local columns are stored dense (see [`LocalJacobian`]).
+pub const DENSE_MAX_COLS: usize = 32;
+
+/// How a [`LocalJacobian`] finds the value of entry (row, column).
+#[derive(Debug)]
+pub(crate) enum Index<'a> {
+    /// Row-major, `row · n_cols + col`.
+    Dense,
+    /// On a structure: the columns of row r are `cols[row_ptr[r]..row_ptr[r + 1]]`, sorted;
+    /// the entry's value is at the same position.
+    Sparse {
+        row_ptr: &'a [u32],
+        cols: &'a [u32],
+    },
+    /// No values: the entries set are listed (to find a structure; allocates).
+    Record(&'a mut Vec<(u32, u32)>),
+}
+
+/// The list of entries a [`LocalJacobian`] has set, as their positions in its values, and a
+/// mark per position.
 #[derive(Debug)]
 pub(crate) struct Touched<'a> {
-    pub(crate) list: &'a mut Vec<(u32, u32)>,
+    pub(crate) list: &'a mut Vec<u32>,
     pub(crate) mark: &'a mut [bool],
 }
 
 impl<'a> LocalJacobian<'a> {
-    /// A view of `values` (row-major, `shape.len()` of them) with this shape; not zeroed.
+    /// A dense view of `values` (row-major, `shape.len()` of them) with this shape; not
+    /// zeroed.
     ///
     /// # Panics
     /// If `values` does not have `shape.len()` entries.
@@ -212,34 +242,80 @@ impl<'a> LocalJacobian<'a> {
         Self {
             shape,
             values,
+            index: Index::Dense,
             touched: None,
+            outside: false,
         }
     }
 
-    /// As [`new`](Self::new), keeping the list of entries set in `touched` (its marks all
-    /// false and `values` all zero on entry; `list` has room for every entry, so pushing
-    /// never allocates).
+    /// A view of `values` (all zero, one per entry of `index`) keeping the list of entries
+    /// set in `touched` (its marks all false on entry; `list` has room for every entry, so
+    /// pushing never allocates).
     pub(crate) fn tracked(
         shape: &'a LocalShape,
         values: &'a mut [f64],
+        index: Index<'a>,
         touched: Touched<'a>,
     ) -> Self {
-        assert_eq!(values.len(), shape.len(), "local Jacobian buffer size");
         Self {
             shape,
             values,
+            index,
             touched: Some(touched),
+            outside: false,
         }
     }
 
-    fn note(&mut self, row: usize, col: usize, index: usize) {
+    /// No values: every entry set is pushed to `list` as (row, column).
+    pub(crate) fn recording(shape: &'a LocalShape, list: &'a mut Vec<(u32, u32)>) -> Self {
+        Self {
+            shape,
+            values: &mut [],
+            index: Index::Record(list),
+            touched: None,
+            outside: false,
+        }
+    }
+
+    /// Whether an entry outside the block's structure was set (and dropped).
+    pub(crate) fn outside(&self) -> bool {
+        self.outside
+    }
+
+    /// Position of entry (row, col) in `values`; `None` outside the structure or when
+    /// recording (the entry is then noted).
+    fn position(&mut self, row: usize, col: usize) -> Option<usize> {
+        debug_assert!(
+            row < self.shape.n_rows && col < self.shape.n_cols,
+            "entry ({row}, {col}) of a {}×{} block",
+            self.shape.n_rows,
+            self.shape.n_cols
+        );
+        // shapes are far below u32::MAX rows or columns (a block is rows × columns)
+        let i = match &mut self.index {
+            Index::Dense => row * self.shape.n_cols + col,
+            Index::Sparse { row_ptr, cols } => {
+                let (a, b) = (row_ptr[row] as usize, row_ptr[row + 1] as usize);
+                match cols[a..b].binary_search(&(col as u32)) {
+                    Ok(k) => a + k,
+                    Err(_) => {
+                        self.outside = true;
+                        return None;
+                    }
+                }
+            }
+            Index::Record(list) => {
+                list.push((row as u32, col as u32));
+                return None;
+            }
+        };
         if let Some(t) = &mut self.touched {
-            if !t.mark[index] {
-                t.mark[index] = true;
-                // shapes are far below u32::MAX rows or columns (a block is rows × columns)
-                t.list.push((row as u32, col as u32));
+            if !t.mark[i] {
+                t.mark[i] = true;
+                t.list.push(i as u32);
             }
         }
+        Some(i)
     }
 
     /// The shape (rows and columns).
@@ -302,32 +378,40 @@ impl<'a> LocalJacobian<'a> {
 
     /// Set entry (row, col).
     pub fn set(&mut self, row: usize, col: usize, v: f64) {
-        let i = row * self.shape.n_cols + col;
-        self.values[i] = v;
-        self.note(row, col, i);
+        if let Some(i) = self.position(row, col) {
+            self.values[i] = v;
+        }
     }
 
     /// Add `v` to entry (row, col).
     pub fn add(&mut self, row: usize, col: usize, v: f64) {
-        let i = row * self.shape.n_cols + col;
-        self.values[i] += v;
-        self.note(row, col, i);
+        if let Some(i) = self.position(row, col) {
+            self.values[i] += v;
+        }
     }
 
-    /// Entry (row, col).
+    /// Entry (row, col) (0 where the block stores nothing).
     #[must_use]
     pub fn get(&self, row: usize, col: usize) -> f64 {
-        self.values[row * self.shape.n_cols + col]
+        match &self.index {
+            Index::Dense => self.values[row * self.shape.n_cols + col],
+            Index::Sparse { row_ptr, cols } => {
+                let (a, b) = (row_ptr[row] as usize, row_ptr[row + 1] as usize);
+                cols[a..b]
+                    .binary_search(&(col as u32))
+                    .map_or(0.0, |k| self.values[a + k])
+            }
+            Index::Record(_) => 0.0,
+        }
     }
 
     /// Set every entry to zero.
     pub fn zero(&mut self) {
         match &mut self.touched {
             Some(t) => {
-                for &(r, c) in t.list.iter() {
-                    let i = r as usize * self.shape.n_cols + c as usize;
-                    self.values[i] = 0.0;
-                    t.mark[i] = false;
+                for &i in t.list.iter() {
+                    self.values[i as usize] = 0.0;
+                    t.mark[i as usize] = false;
                 }
                 t.list.clear();
             }
@@ -335,7 +419,8 @@ impl<'a> LocalJacobian<'a> {
         }
     }
 
-    /// The values, row-major.
+    /// The values: row-major for a dense block, in structure order (row by row, columns
+    /// sorted) for a sparse one.
     #[must_use]
     pub fn values(&self) -> &[f64] {
         self.values
