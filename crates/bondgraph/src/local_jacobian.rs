@@ -102,6 +102,7 @@ impl LocalShape {
 
     /// Column of component `k` of the effort at `port`.
     #[must_use]
+    #[inline]
     pub fn effort_col(&self, port: usize, k: usize) -> usize {
         let (c, dim) = self.ports[port];
         debug_assert!(k < dim, "effort component {k} of a {dim}-port");
@@ -110,6 +111,7 @@ impl LocalShape {
 
     /// Column of component `k` of the flow *into the element* at `port`.
     #[must_use]
+    #[inline]
     pub fn flow_col(&self, port: usize, k: usize) -> usize {
         let (c, dim) = self.ports[port];
         debug_assert!(k < dim, "flow component {k} of a {dim}-port");
@@ -118,6 +120,7 @@ impl LocalShape {
 
     /// Column of component `k` of signal input `i`.
     #[must_use]
+    #[inline]
     pub fn input_col(&self, i: usize, k: usize) -> usize {
         let (c, dim) = self.inputs[i];
         debug_assert!(k < dim, "component {k} of a {dim}-signal");
@@ -126,6 +129,7 @@ impl LocalShape {
 
     /// Column of the element's own state `k`.
     #[must_use]
+    #[inline]
     pub fn state_col(&self, k: usize) -> usize {
         debug_assert!(k < self.n_states, "state {k} of {}", self.n_states);
         self.states + k
@@ -136,6 +140,7 @@ impl LocalShape {
     /// # Panics
     /// If the stage does not write `slot`.
     #[must_use]
+    #[inline]
     pub fn row(&self, slot: Slot, k: usize) -> usize {
         match self.rows.iter().find(|r| r.0 == slot) {
             Some(&(_, r, dim)) => {
@@ -177,14 +182,15 @@ impl LocalShape {
 /// [`state_col`](Self::state_col), [`row`](Self::row) (and
 /// [`derivative_row`](Self::derivative_row)), then [`set`](Self::set) / [`add`](Self::add).
 ///
-/// **Storage.** A block of up to [`DENSE_MAX_COLS`] columns is dense, row-major. A wider one
-/// (a line of many segments, a manipulator field) is stored on its *structure*: the entries
-/// the element set when the core first asked (at the initial state), each row's columns
-/// sorted — so a line of N segments holds about 5N entries, not 4N². An element with such a
-/// block should set the same entries wherever it is asked (a zero is fine); an entry outside
-/// the structure is noted, and the core then widens the structure and assembles the
-/// Jacobian again. Either way the block is a view into buffers sized when the plan is
-/// compiled: filling it never allocates.
+/// **Structure.** A block of up to [`DENSE_MAX_COLS`] columns may set any entry. A wider one
+/// (a line of many segments, a manipulator field, a junction of many bonds) has a
+/// *structure*: the entries the element set when the core first asked (at the initial
+/// state). Such an element should set the same entries wherever it is asked (a zero is
+/// fine); a nonzero entry outside the structure is noted, and the core then widens the
+/// structure and assembles the Jacobian again. A block of up to [`DENSE_MAX_ENTRIES`] entries is
+/// stored dense, row-major; a larger one on its structure, each row's columns sorted — so a
+/// line of N segments holds about 5N values, not 4N². Either way the block is a view into
+/// buffers sized when the plan is compiled: filling it never allocates.
 ///
 /// A resistor in conductance causality, f_in = e / r, fills one entry:
 /// ```
@@ -198,15 +204,17 @@ pub struct LocalJacobian<'a> {
     shape: &'a LocalShape,
     values: &'a mut [f64],
     index: Index<'a>,
-    /// The entries set so far, when the core keeps a list of them (so that it reads, and
-    /// zeroes again, only those).
-    touched: Option<Touched<'a>>,
-    /// Whether an entry outside a sparse structure was set (and dropped).
+    /// Whether a nonzero entry outside a sparse structure was set (and dropped).
     outside: bool,
 }
 
-/// Blocks with up to this many local columns are stored dense (see [`LocalJacobian`]).
+/// Blocks with up to this many local columns may set any entry; wider ones have a structure
+/// (see [`LocalJacobian`]).
 pub const DENSE_MAX_COLS: usize = 32;
+
+/// Blocks of up to this many entries (rows × columns) are stored dense (see
+/// [`LocalJacobian`]).
+pub const DENSE_MAX_ENTRIES: usize = 1024;
 
 /// How a [`LocalJacobian`] finds the value of entry (row, column).
 #[derive(Debug)]
@@ -215,20 +223,9 @@ pub(crate) enum Index<'a> {
     Dense,
     /// On a structure: the columns of row r are `cols[row_ptr[r]..row_ptr[r + 1]]`, sorted;
     /// the entry's value is at the same position.
-    Sparse {
-        row_ptr: &'a [u32],
-        cols: &'a [u32],
-    },
+    Sparse { row_ptr: &'a [u32], cols: &'a [u32] },
     /// No values: the entries set are listed (to find a structure; allocates).
     Record(&'a mut Vec<(u32, u32)>),
-}
-
-/// The list of entries a [`LocalJacobian`] has set, as their positions in its values, and a
-/// mark per position.
-#[derive(Debug)]
-pub(crate) struct Touched<'a> {
-    pub(crate) list: &'a mut Vec<u32>,
-    pub(crate) mark: &'a mut [bool],
 }
 
 impl<'a> LocalJacobian<'a> {
@@ -243,25 +240,16 @@ impl<'a> LocalJacobian<'a> {
             shape,
             values,
             index: Index::Dense,
-            touched: None,
             outside: false,
         }
     }
 
-    /// A view of `values` (all zero, one per entry of `index`) keeping the list of entries
-    /// set in `touched` (its marks all false on entry; `list` has room for every entry, so
-    /// pushing never allocates).
-    pub(crate) fn tracked(
-        shape: &'a LocalShape,
-        values: &'a mut [f64],
-        index: Index<'a>,
-        touched: Touched<'a>,
-    ) -> Self {
+    /// A view of `values` (all zero, one per entry of `index`).
+    pub(crate) fn on(shape: &'a LocalShape, values: &'a mut [f64], index: Index<'a>) -> Self {
         Self {
             shape,
             values,
             index,
-            touched: Some(touched),
             outside: false,
         }
     }
@@ -272,18 +260,18 @@ impl<'a> LocalJacobian<'a> {
             shape,
             values: &mut [],
             index: Index::Record(list),
-            touched: None,
             outside: false,
         }
     }
 
-    /// Whether an entry outside the block's structure was set (and dropped).
+    /// Whether a nonzero entry outside the block's structure was set (and dropped).
     pub(crate) fn outside(&self) -> bool {
         self.outside
     }
 
     /// Position of entry (row, col) in `values`; `None` outside the structure or when
-    /// recording (the entry is then noted).
+    /// recording (the entry is then listed).
+    #[inline]
     fn position(&mut self, row: usize, col: usize) -> Option<usize> {
         debug_assert!(
             row < self.shape.n_rows && col < self.shape.n_cols,
@@ -296,25 +284,13 @@ impl<'a> LocalJacobian<'a> {
             Index::Dense => row * self.shape.n_cols + col,
             Index::Sparse { row_ptr, cols } => {
                 let (a, b) = (row_ptr[row] as usize, row_ptr[row + 1] as usize);
-                match cols[a..b].binary_search(&(col as u32)) {
-                    Ok(k) => a + k,
-                    Err(_) => {
-                        self.outside = true;
-                        return None;
-                    }
-                }
+                a + cols[a..b].binary_search(&(col as u32)).ok()?
             }
             Index::Record(list) => {
                 list.push((row as u32, col as u32));
                 return None;
             }
         };
-        if let Some(t) = &mut self.touched {
-            if !t.mark[i] {
-                t.mark[i] = true;
-                t.list.push(i as u32);
-            }
-        }
         Some(i)
     }
 
@@ -326,36 +302,42 @@ impl<'a> LocalJacobian<'a> {
 
     /// Number of rows.
     #[must_use]
+    #[inline]
     pub fn n_rows(&self) -> usize {
         self.shape.n_rows
     }
 
     /// Number of columns.
     #[must_use]
+    #[inline]
     pub fn n_cols(&self) -> usize {
         self.shape.n_cols
     }
 
     /// Column of component `k` of the effort at `port`.
     #[must_use]
+    #[inline]
     pub fn effort_col(&self, port: usize, k: usize) -> usize {
         self.shape.effort_col(port, k)
     }
 
     /// Column of component `k` of the flow *into the element* at `port`.
     #[must_use]
+    #[inline]
     pub fn flow_col(&self, port: usize, k: usize) -> usize {
         self.shape.flow_col(port, k)
     }
 
     /// Column of component `k` of signal input `i`.
     #[must_use]
+    #[inline]
     pub fn input_col(&self, i: usize, k: usize) -> usize {
         self.shape.input_col(i, k)
     }
 
     /// Column of the element's own state `k`.
     #[must_use]
+    #[inline]
     pub fn state_col(&self, k: usize) -> usize {
         self.shape.state_col(k)
     }
@@ -365,33 +347,40 @@ impl<'a> LocalJacobian<'a> {
     /// # Panics
     /// If the stage does not write `slot`.
     #[must_use]
+    #[inline]
     pub fn row(&self, slot: Slot, k: usize) -> usize {
         self.shape.row(slot, k)
     }
 
     /// Row of the derivative of the element's state `k` (in `derivative_partials`).
     #[must_use]
+    #[inline]
     pub fn derivative_row(&self, k: usize) -> usize {
         debug_assert!(k < self.shape.n_rows, "state {k} of {}", self.shape.n_rows);
         k
     }
 
     /// Set entry (row, col).
+    #[inline]
     pub fn set(&mut self, row: usize, col: usize, v: f64) {
-        if let Some(i) = self.position(row, col) {
-            self.values[i] = v;
+        match self.position(row, col) {
+            Some(i) => self.values[i] = v,
+            None => self.outside |= v != 0.0,
         }
     }
 
     /// Add `v` to entry (row, col).
+    #[inline]
     pub fn add(&mut self, row: usize, col: usize, v: f64) {
-        if let Some(i) = self.position(row, col) {
-            self.values[i] += v;
+        match self.position(row, col) {
+            Some(i) => self.values[i] += v,
+            None => self.outside |= v != 0.0,
         }
     }
 
     /// Entry (row, col) (0 where the block stores nothing).
     #[must_use]
+    #[inline]
     pub fn get(&self, row: usize, col: usize) -> f64 {
         match &self.index {
             Index::Dense => self.values[row * self.shape.n_cols + col],
@@ -407,16 +396,7 @@ impl<'a> LocalJacobian<'a> {
 
     /// Set every entry to zero.
     pub fn zero(&mut self) {
-        match &mut self.touched {
-            Some(t) => {
-                for &i in t.list.iter() {
-                    self.values[i as usize] = 0.0;
-                    t.mark[i as usize] = false;
-                }
-                t.list.clear();
-            }
-            None => self.values.fill(0.0),
-        }
+        self.values.fill(0.0);
     }
 
     /// The values: row-major for a dense block, in structure order (row by row, columns

@@ -9,17 +9,17 @@
 //! input and own state) is perturbed, only that stage is re-run, and the difference of its
 //! writes is chained like an analytic partial.
 //!
-//! The chain rule is compiled once ([`compile`]): each gradient is stored on its sparsity
+//! The chain rule is compiled once (`compile`): each gradient is stored on its sparsity
 //! pattern (the states it depends on), and each entry of a local block becomes a run of
 //! `gradient[d] += value · gradient[s]` updates in a flat list. A Jacobian is then one pass
-//! of the plan and of that list ([`pass`]); it writes a dense matrix or the values of a
-//! sparse pattern ([`sparse`]) alike, and allocates nothing. Nothing in it is n wide: the
+//! of the plan and of that list (`pass`); it writes a dense matrix or the values of a
+//! sparse pattern (`sparse`) alike, and allocates nothing. Nothing in it is n wide: the
 //! work of a Jacobian is the number of nonzero partials times the pattern sizes they carry.
 //!
-//! - [`compile`]: the plan of updates, gradient patterns, local-block structures.
-//! - [`pass`]: one pass of the plan carrying gradients, local differences.
-//! - [`sparse`]: the sparsity pattern and the sparse target.
-//! - [`outputs`]: ∂y/∂x and ∂y/∂u of any probe (linearisation).
+//! - `compile`: the plan of updates, gradient patterns, local-block structures.
+//! - `pass`: one pass of the plan carrying gradients, local differences.
+//! - `sparse`: the sparsity pattern and the sparse target.
+//! - `outputs`: ∂y/∂x and ∂y/∂u of any probe (linearisation).
 
 use std::cell::RefMut;
 

@@ -13,7 +13,7 @@
 use std::ops::Range;
 
 use crate::element::{Element, Io, Layout, Slot, Source};
-use crate::local_jacobian::{LocalJacobian, LocalShape, DENSE_MAX_COLS};
+use crate::local_jacobian::{LocalJacobian, LocalShape, DENSE_MAX_COLS, DENSE_MAX_ENTRIES};
 
 use super::super::StateEquations;
 
@@ -74,11 +74,28 @@ pub(super) enum Target {
     Derivatives,
 }
 
+/// How a block's partials are stored.
+#[derive(Debug)]
+pub(super) enum Storage {
+    /// Row-major; with a mask, the structure of a wide block (the entries it may set).
+    Dense(Option<Vec<bool>>),
+    /// On the structure: row starts, and the sorted columns of each row.
+    Sparse(Vec<u32>, Vec<u32>),
+}
+
+/// `g[d..d + len] += value · g[s..s + len]`: one run of the chain rule (the source always
+/// lies before the destination: it was written by an earlier block, or is a unit gradient).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct Run {
+    pub(super) d: u32,
+    pub(super) s: u32,
+    pub(super) len: u32,
+}
+
 /// The compiled partials of a block: where each entry's value lies, and its updates.
 #[derive(Debug)]
 pub(super) struct Entries {
-    /// `None`: dense, row-major; else the structure (row starts, sorted columns per row).
-    pub(super) structure: Option<(Vec<u32>, Vec<u32>)>,
+    pub(super) storage: Storage,
     /// Number of entries.
     pub(super) len: usize,
     /// Per entry: the row's factor times the column's.
@@ -121,8 +138,8 @@ pub(in crate::equations) struct Compiled {
     /// The column of each gradient position (the first `width` are the unit gradients).
     pub(super) cols: Vec<u32>,
     pub(super) blocks: Vec<BlockCode>,
-    /// (destination, source) positions: `g[d] += value · g[s]`.
-    pub(super) updates: Vec<(u32, u32)>,
+    /// The runs of every entry, block after block.
+    pub(super) updates: Vec<Run>,
     /// Each effort, flow and signal scalar's gradient after the pass.
     pub(super) slots: Vec<Span>,
     /// The Jacobian's rows: state index and gradient.
@@ -133,9 +150,30 @@ pub(in crate::equations) struct Compiled {
     pub(super) no_structure: Vec<u32>,
 }
 
+impl Entries {
+    /// The (row, column) of every entry a wide block may set (in a plan compiled before).
+    fn structure(&self, n_cols: usize) -> Vec<(u32, u32)> {
+        match &self.storage {
+            Storage::Dense(None) => Vec::new(),
+            Storage::Dense(Some(mask)) => (0..mask.len())
+                .filter(|&i| mask[i])
+                .map(|i| ((i / n_cols) as u32, (i % n_cols) as u32))
+                .collect(),
+            Storage::Sparse(row_ptr, cols) => (0..row_ptr.len() - 1)
+                .flat_map(|r| {
+                    let (a, e) = (row_ptr[r] as usize, row_ptr[r + 1] as usize);
+                    cols[a..e].iter().map(move |&col| (r as u32, col))
+                })
+                .collect(),
+        }
+    }
+}
+
 /// Sorted union of the patterns of `srcs`.
 fn union(cols: &[u32], srcs: impl Iterator<Item = Src>) -> Vec<u32> {
-    let mut out: Vec<u32> = srcs.flat_map(|s| cols[s.span.range()].iter().copied()).collect();
+    let mut out: Vec<u32> = srcs
+        .flat_map(|s| cols[s.span.range()].iter().copied())
+        .collect();
     out.sort_unstable();
     out.dedup();
     out
@@ -301,14 +339,11 @@ impl StateEquations {
         let ws = &mut *ws;
         let mut dx = vec![0.0; n];
         let mut record = Vec::new();
-        let targets = order
-            .iter()
-            .map(|&(id, s)| (id, Target::Stage(s)))
-            .chain(
-                (0..self.layouts.len())
-                    .filter(|&id| self.layouts[id].n_states > 0)
-                    .map(|id| (id, Target::Derivatives)),
-            );
+        let targets = order.iter().map(|&(id, s)| (id, Target::Stage(s))).chain(
+            (0..self.layouts.len())
+                .filter(|&id| self.layouts[id].n_states > 0)
+                .map(|id| (id, Target::Derivatives)),
+        );
         for (k, (id, target)) in targets.enumerate() {
             let l = &self.layouts[id];
             let element: &dyn Element = self.graph.node(id).element.as_ref();
@@ -354,20 +389,12 @@ impl StateEquations {
                     record.clear();
                 }
                 let mut entries: Vec<(u32, u32)> = record.clone();
-                let mut had_entries = false;
-                let mut had_diffs = false;
+                let (mut had_entries, mut had_diffs) = (false, false);
                 if let Some(b) = before {
                     had_diffs = b.diffs.is_some();
-                    if let Some(Entries {
-                        structure: Some((row_ptr, cols)),
-                        ..
-                    }) = &b.entries
-                    {
+                    if let Some(e) = &b.entries {
                         had_entries = true;
-                        for r in 0..m {
-                            let (a, e) = (row_ptr[r] as usize, row_ptr[r + 1] as usize);
-                            entries.extend(cols[a..e].iter().map(|&col| (r as u32, col)));
-                        }
+                        entries.extend(e.structure(b.shape.n_cols()));
                     }
                 }
                 entries.sort_unstable();
@@ -380,7 +407,11 @@ impl StateEquations {
                     row_ptr[r + 1] += row_ptr[r];
                 }
                 let cols: Vec<u32> = entries.iter().map(|e| e.1).collect();
-                (gives || had_entries, !gives || had_diffs, Some((row_ptr, cols)))
+                (
+                    gives || had_entries,
+                    !gives || had_diffs,
+                    Some((row_ptr, cols)),
+                )
             } else {
                 (true, true, None)
             };
@@ -389,13 +420,19 @@ impl StateEquations {
                 Some((row_ptr, cols)) if !with_diffs => (0..m)
                     .map(|r| {
                         let (a, e) = (row_ptr[r] as usize, row_ptr[r + 1] as usize);
-                        union(&c.cols, cols[a..e].iter().map(|&col| col_srcs[col as usize]))
+                        union(
+                            &c.cols,
+                            cols[a..e].iter().map(|&col| col_srcs[col as usize]),
+                        )
                     })
                     .collect(),
                 _ => {
                     let all = union(
                         &c.cols,
-                        col_srcs.iter().chain(fd_cells.iter().map(|f| &f.1)).copied(),
+                        col_srcs
+                            .iter()
+                            .chain(fd_cells.iter().map(|f| &f.1))
+                            .copied(),
                     );
                     vec![all; m]
                 }
@@ -413,38 +450,67 @@ impl StateEquations {
                 start: start as u32,
                 len: (c.cols.len() - start) as u32,
             };
-            // g[row r] += value · g[src], state by state of src's pattern.
+            // g[row r] += value · g[src], state by state of src's pattern, in runs.
             let updates = |c: &mut Compiled, r: usize, src: Src| {
                 let dst = row_spans[r].start as usize;
+                let from = c.updates.len();
                 for q in src.span.range() {
-                    let j = c.cols[q];
-                    if let Ok(pos) = patterns[r].binary_search(&j) {
-                        c.updates.push(((dst + pos) as u32, q as u32));
+                    let Ok(pos) = patterns[r].binary_search(&c.cols[q]) else {
+                        continue;
+                    };
+                    let (d, s) = ((dst + pos) as u32, q as u32);
+                    let mine = c.updates.len() > from;
+                    match c.updates.last_mut() {
+                        Some(run) if mine && run.d + run.len == d && run.s + run.len == s => {
+                            run.len += 1;
+                        }
+                        _ => c.updates.push(Run { d, s, len: 1 }),
                     }
                 }
             };
             let entries = with_entries.then(|| {
                 let nc = shape.n_cols();
-                let list: Vec<(usize, usize)> = match &structure {
-                    None => (0..m).flat_map(|r| (0..nc).map(move |col| (r, col))).collect(),
+                let dense = shape.len() <= DENSE_MAX_ENTRIES;
+                // Each entry's (row, column), in storage order, and whether it is compiled.
+                let list: Vec<(usize, usize, bool)> = match &structure {
+                    None => (0..m)
+                        .flat_map(|r| (0..nc).map(move |col| (r, col, true)))
+                        .collect(),
+                    Some((row_ptr, cols)) if dense => {
+                        let mut known = vec![false; m * nc];
+                        for r in 0..m {
+                            let (a, e) = (row_ptr[r] as usize, row_ptr[r + 1] as usize);
+                            for &col in &cols[a..e] {
+                                known[r * nc + col as usize] = true;
+                            }
+                        }
+                        (0..m * nc).map(|i| (i / nc, i % nc, known[i])).collect()
+                    }
                     Some((row_ptr, cols)) => (0..m)
                         .flat_map(|r| {
                             let (a, e) = (row_ptr[r] as usize, row_ptr[r + 1] as usize);
-                            cols[a..e].iter().map(move |&col| (r, col as usize))
+                            cols[a..e].iter().map(move |&col| (r, col as usize, true))
                         })
                         .collect(),
                 };
                 let mut fac = Vec::with_capacity(list.len());
                 let mut first = Vec::with_capacity(list.len() + 1);
-                for &(r, col) in &list {
+                for &(r, col, known) in &list {
                     let src = col_srcs[col];
                     fac.push(rows[r].1 * src.scale);
                     first.push(c.updates.len() as u32);
-                    updates(&mut c, r, src);
+                    if known {
+                        updates(&mut c, r, src);
+                    }
                 }
                 first.push(c.updates.len() as u32);
+                let storage = match structure.clone() {
+                    None => Storage::Dense(None),
+                    Some(_) if dense => Storage::Dense(Some(list.iter().map(|e| e.2).collect())),
+                    Some((row_ptr, cols)) => Storage::Sparse(row_ptr, cols),
+                };
                 Entries {
-                    structure: structure.clone(),
+                    storage,
                     len: list.len(),
                     fac,
                     first,

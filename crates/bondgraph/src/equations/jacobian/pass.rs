@@ -3,9 +3,9 @@
 
 use crate::element::{Element, Io};
 use crate::equations::{StateEquations, StateInfo, Workspace};
-use crate::local_jacobian::{Index, LocalJacobian, Touched};
+use crate::local_jacobian::{Index, LocalJacobian};
 
-use super::compile::{BlockCode, Cell, Compiled, Src, Target};
+use super::compile::{BlockCode, Cell, Compiled, Run, Src, Storage, Target};
 use super::Out;
 
 /// Local differences use central differences up to this many perturbed scalars per block,
@@ -18,11 +18,8 @@ pub(in crate::equations) struct Work {
     /// Every gradient's values, on its pattern ([`Compiled::cols`]); the first `width` are
     /// the unit gradients (1).
     pub(super) g: Vec<f64>,
-    /// A local block's values (all zero between blocks), the entries an element set in it
-    /// and their marks.
+    /// A local block's values (all zero between blocks).
     local: Vec<f64>,
-    touched: Vec<u32>,
-    mark: Vec<bool>,
     /// Row values at the evaluation point, and perturbed.
     base: Vec<f64>,
     plus: Vec<f64>,
@@ -42,8 +39,6 @@ impl Work {
         Self {
             g,
             local: vec![0.0; c.max_entries],
-            touched: Vec::with_capacity(c.max_entries),
-            mark: vec![false; c.max_entries],
             base: vec![0.0; c.max_rows],
             plus: vec![0.0; c.max_rows],
             x: vec![0.0; states.len()],
@@ -53,11 +48,16 @@ impl Work {
     }
 }
 
-/// `g[d] += c · g[s]` for every (d, s) of `updates`.
+/// `g[d..d + len] += c · g[s..s + len]` for every run.
 #[inline]
-fn apply(g: &mut [f64], updates: &[(u32, u32)], c: f64) {
-    for &(d, s) in updates {
-        g[d as usize] += c * g[s as usize];
+fn apply(g: &mut [f64], runs: &[Run], c: f64) {
+    for run in runs {
+        let (d, s, len) = (run.d as usize, run.s as usize, run.len as usize);
+        debug_assert!(s + len <= d, "a run's source lies before its destination");
+        let (src, dst) = g.split_at_mut(d);
+        for (a, b) in dst[..len].iter_mut().zip(&src[s..s + len]) {
+            *a += c * b;
+        }
     }
 }
 
@@ -128,9 +128,9 @@ impl<'a> Pass<'a> {
         let layout = &self.eqs.layouts[b.id];
         let element: &dyn Element = self.eqs.graph.node(b.id).element.as_ref();
         let (index, len) = match &b.entries {
-            Some(e) => match &e.structure {
-                None => (Index::Dense, e.len),
-                Some((row_ptr, cols)) => (Index::Sparse { row_ptr, cols }, e.len),
+            Some(e) => match &e.storage {
+                Storage::Dense(_) => (Index::Dense, e.len),
+                Storage::Sparse(row_ptr, cols) => (Index::Sparse { row_ptr, cols }, e.len),
             },
             None => (
                 Index::Sparse {
@@ -140,11 +140,7 @@ impl<'a> Pass<'a> {
                 0,
             ),
         };
-        let touched = Touched {
-            list: &mut self.w.touched,
-            mark: &mut self.w.mark[..len],
-        };
-        let mut jac = LocalJacobian::tracked(&b.shape, &mut self.w.local[..len], index, touched);
+        let mut jac = LocalJacobian::on(&b.shape, &mut self.w.local[..len], index);
         let io = Io {
             t: self.t,
             x: &self.w.x,
@@ -206,23 +202,30 @@ impl<'a> Pass<'a> {
         let code = self.code;
         let updates = &code.updates;
         let w = &mut *self.w;
-        if let (true, Some(e)) = (gives, &b.entries) {
-            for &i in &w.touched {
-                let i = i as usize;
-                let v = std::mem::take(&mut w.local[i]);
-                w.mark[i] = false;
-                if v != 0.0 {
-                    let run = e.first[i] as usize..e.first[i + 1] as usize;
-                    apply(&mut w.g, &updates[run], v * e.fac[i]);
+        if let Some(e) = &b.entries {
+            // Entry by entry in storage order (row by row, columns ascending), each value
+            // zeroed again for the next block.
+            let mask = match &e.storage {
+                Storage::Dense(Some(mask)) => Some(mask),
+                _ => None,
+            };
+            for i in 0..e.len {
+                let v = w.local[i];
+                if v == 0.0 {
+                    continue;
                 }
-            }
-        } else {
-            for &i in &w.touched {
-                w.local[i as usize] = 0.0;
-                w.mark[i as usize] = false;
+                w.local[i] = 0.0;
+                if !gives {
+                    continue;
+                }
+                let run = e.first[i] as usize..e.first[i + 1] as usize;
+                if run.is_empty() && mask.is_some_and(|m| !m[i]) {
+                    // outside a wide block's structure
+                    self.stale = true;
+                }
+                apply(&mut w.g, &updates[run], v * e.fac[i]);
             }
         }
-        w.touched.clear();
         if gives {
             return;
         }
