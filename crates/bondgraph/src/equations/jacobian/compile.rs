@@ -150,6 +150,15 @@ pub(in crate::equations) struct Compiled {
     pub(super) no_structure: Vec<u32>,
 }
 
+/// A block before compiling: its shape, rows (cell, factor), the columns it writes and the
+/// cells a local difference reads.
+struct BlockLayout {
+    shape: LocalShape,
+    rows: Vec<(Cell, f64)>,
+    written: Vec<usize>,
+    cells: Vec<Cell>,
+}
+
 impl Entries {
     /// The (row, column) of every entry a wide block may set (in a plan compiled before).
     fn structure(&self, n_cols: usize) -> Vec<(u32, u32)> {
@@ -245,7 +254,7 @@ impl StateEquations {
         id: usize,
         target: Target,
         causality: &[crate::bond::PortCausality],
-    ) -> (LocalShape, Vec<(Cell, f64)>, Vec<usize>, Vec<Cell>) {
+    ) -> BlockLayout {
         let l = &self.layouts[id];
         let element = self.graph.node(id).element.as_ref();
         let own_states = (0..l.n_states).map(|k| Cell::State(l.state_offset + k));
@@ -288,7 +297,12 @@ impl StateEquations {
                     }
                 }
                 cells.extend(own_states);
-                (shape, rows, written, cells)
+                BlockLayout {
+                    shape,
+                    rows,
+                    written,
+                    cells,
+                }
             }
             Target::Derivatives => {
                 let shape = LocalShape::derivatives(l);
@@ -304,7 +318,12 @@ impl StateEquations {
                     cells.extend(Self::input_cells(l, i).flatten());
                 }
                 cells.extend(own_states);
-                (shape, rows, Vec::new(), cells)
+                BlockLayout {
+                    shape,
+                    rows,
+                    written: Vec::new(),
+                    cells,
+                }
             }
         }
     }
@@ -363,7 +382,12 @@ impl StateEquations {
                     element.derivatives(&io, &mut dx[o..o + m]);
                 }
             }
-            let (shape, rows, written, cells) = self.block_layout(id, target, &causality);
+            let BlockLayout {
+                shape,
+                rows,
+                written,
+                cells,
+            } = self.block_layout(id, target, &causality);
             let mut col_srcs = self.column_srcs(id, &c.slots);
             for &w in &written {
                 col_srcs[w] = Src::NONE;
