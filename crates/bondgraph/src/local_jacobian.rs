@@ -102,6 +102,7 @@ impl LocalShape {
 
     /// Column of component `k` of the effort at `port`.
     #[must_use]
+    #[inline]
     pub fn effort_col(&self, port: usize, k: usize) -> usize {
         let (c, dim) = self.ports[port];
         debug_assert!(k < dim, "effort component {k} of a {dim}-port");
@@ -110,6 +111,7 @@ impl LocalShape {
 
     /// Column of component `k` of the flow *into the element* at `port`.
     #[must_use]
+    #[inline]
     pub fn flow_col(&self, port: usize, k: usize) -> usize {
         let (c, dim) = self.ports[port];
         debug_assert!(k < dim, "flow component {k} of a {dim}-port");
@@ -118,6 +120,7 @@ impl LocalShape {
 
     /// Column of component `k` of signal input `i`.
     #[must_use]
+    #[inline]
     pub fn input_col(&self, i: usize, k: usize) -> usize {
         let (c, dim) = self.inputs[i];
         debug_assert!(k < dim, "component {k} of a {dim}-signal");
@@ -126,6 +129,7 @@ impl LocalShape {
 
     /// Column of the element's own state `k`.
     #[must_use]
+    #[inline]
     pub fn state_col(&self, k: usize) -> usize {
         debug_assert!(k < self.n_states, "state {k} of {}", self.n_states);
         self.states + k
@@ -136,6 +140,7 @@ impl LocalShape {
     /// # Panics
     /// If the stage does not write `slot`.
     #[must_use]
+    #[inline]
     pub fn row(&self, slot: Slot, k: usize) -> usize {
         match self.rows.iter().find(|r| r.0 == slot) {
             Some(&(_, r, dim)) => {
@@ -154,7 +159,7 @@ impl LocalShape {
 }
 
 /// The partial derivatives of one stage of an element (or of its state derivatives) with
-/// respect to the element's local variables: a dense row-major block the element fills in
+/// respect to the element's local variables: a block the element fills in
 /// [`Element::stage_partials`] and
 /// [`Element::derivative_partials`].
 ///
@@ -176,8 +181,16 @@ impl LocalShape {
 /// [`flow_col`](Self::flow_col), [`input_col`](Self::input_col),
 /// [`state_col`](Self::state_col), [`row`](Self::row) (and
 /// [`derivative_row`](Self::derivative_row)), then [`set`](Self::set) / [`add`](Self::add).
-/// The block is a view into buffers sized once per element and stage when the plan is built:
-/// filling it never allocates.
+///
+/// **Structure.** A block of up to [`DENSE_MAX_COLS`] columns may set any entry. A wider one
+/// (a line of many segments, a manipulator field, a junction of many bonds) has a
+/// *structure*: the entries the element set when the core first asked (at the initial
+/// state). Such an element should set the same entries wherever it is asked (a zero is
+/// fine); a nonzero entry outside the structure is noted, and the core then widens the
+/// structure and assembles the Jacobian again. A block of up to [`DENSE_MAX_ENTRIES`] entries is
+/// stored dense, row-major; a larger one on its structure, each row's columns sorted — so a
+/// line of N segments holds about 5N values, not 4N². Either way the block is a view into
+/// buffers sized when the plan is compiled: filling it never allocates.
 ///
 /// A resistor in conductance causality, f_in = e / r, fills one entry:
 /// ```
@@ -190,20 +203,34 @@ impl LocalShape {
 pub struct LocalJacobian<'a> {
     shape: &'a LocalShape,
     values: &'a mut [f64],
-    /// The entries set so far, when the core keeps a list of them (so that it reads, and
-    /// zeroes again, only those).
-    touched: Option<Touched<'a>>,
+    index: Index<'a>,
+    /// Whether a nonzero entry outside a sparse structure was set (and dropped).
+    outside: bool,
 }
 
-/// The list of entries a [`LocalJacobian`] has set, as (row, column), and a mark per entry.
+/// Blocks with up to this many local columns may set any entry; wider ones have a structure
+/// (see [`LocalJacobian`]).
+pub const DENSE_MAX_COLS: usize = 32;
+
+/// Blocks of up to this many entries (rows × columns) are stored dense (see
+/// [`LocalJacobian`]).
+pub const DENSE_MAX_ENTRIES: usize = 1024;
+
+/// How a [`LocalJacobian`] finds the value of entry (row, column).
 #[derive(Debug)]
-pub(crate) struct Touched<'a> {
-    pub(crate) list: &'a mut Vec<(u32, u32)>,
-    pub(crate) mark: &'a mut [bool],
+pub(crate) enum Index<'a> {
+    /// Row-major, `row · n_cols + col`.
+    Dense,
+    /// On a structure: the columns of row r are `cols[row_ptr[r]..row_ptr[r + 1]]`, sorted;
+    /// the entry's value is at the same position.
+    Sparse { row_ptr: &'a [u32], cols: &'a [u32] },
+    /// No values: the entries set are listed (to find a structure; allocates).
+    Record(&'a mut Vec<(u32, u32)>),
 }
 
 impl<'a> LocalJacobian<'a> {
-    /// A view of `values` (row-major, `shape.len()` of them) with this shape; not zeroed.
+    /// A dense view of `values` (row-major, `shape.len()` of them) with this shape; not
+    /// zeroed.
     ///
     /// # Panics
     /// If `values` does not have `shape.len()` entries.
@@ -212,34 +239,59 @@ impl<'a> LocalJacobian<'a> {
         Self {
             shape,
             values,
-            touched: None,
+            index: Index::Dense,
+            outside: false,
         }
     }
 
-    /// As [`new`](Self::new), keeping the list of entries set in `touched` (its marks all
-    /// false and `values` all zero on entry; `list` has room for every entry, so pushing
-    /// never allocates).
-    pub(crate) fn tracked(
-        shape: &'a LocalShape,
-        values: &'a mut [f64],
-        touched: Touched<'a>,
-    ) -> Self {
-        assert_eq!(values.len(), shape.len(), "local Jacobian buffer size");
+    /// A view of `values` (all zero, one per entry of `index`).
+    pub(crate) fn on(shape: &'a LocalShape, values: &'a mut [f64], index: Index<'a>) -> Self {
         Self {
             shape,
             values,
-            touched: Some(touched),
+            index,
+            outside: false,
         }
     }
 
-    fn note(&mut self, row: usize, col: usize, index: usize) {
-        if let Some(t) = &mut self.touched {
-            if !t.mark[index] {
-                t.mark[index] = true;
-                // shapes are far below u32::MAX rows or columns (a block is rows × columns)
-                t.list.push((row as u32, col as u32));
-            }
+    /// No values: every entry set is pushed to `list` as (row, column).
+    pub(crate) fn recording(shape: &'a LocalShape, list: &'a mut Vec<(u32, u32)>) -> Self {
+        Self {
+            shape,
+            values: &mut [],
+            index: Index::Record(list),
+            outside: false,
         }
+    }
+
+    /// Whether a nonzero entry outside the block's structure was set (and dropped).
+    pub(crate) fn outside(&self) -> bool {
+        self.outside
+    }
+
+    /// Position of entry (row, col) in `values`; `None` outside the structure or when
+    /// recording (the entry is then listed).
+    #[inline]
+    fn position(&mut self, row: usize, col: usize) -> Option<usize> {
+        debug_assert!(
+            row < self.shape.n_rows && col < self.shape.n_cols,
+            "entry ({row}, {col}) of a {}×{} block",
+            self.shape.n_rows,
+            self.shape.n_cols
+        );
+        // shapes are far below u32::MAX rows or columns (a block is rows × columns)
+        let i = match &mut self.index {
+            Index::Dense => row * self.shape.n_cols + col,
+            Index::Sparse { row_ptr, cols } => {
+                let (a, b) = (row_ptr[row] as usize, row_ptr[row + 1] as usize);
+                a + cols[a..b].binary_search(&(col as u32)).ok()?
+            }
+            Index::Record(list) => {
+                list.push((row as u32, col as u32));
+                return None;
+            }
+        };
+        Some(i)
     }
 
     /// The shape (rows and columns).
@@ -250,36 +302,42 @@ impl<'a> LocalJacobian<'a> {
 
     /// Number of rows.
     #[must_use]
+    #[inline]
     pub fn n_rows(&self) -> usize {
         self.shape.n_rows
     }
 
     /// Number of columns.
     #[must_use]
+    #[inline]
     pub fn n_cols(&self) -> usize {
         self.shape.n_cols
     }
 
     /// Column of component `k` of the effort at `port`.
     #[must_use]
+    #[inline]
     pub fn effort_col(&self, port: usize, k: usize) -> usize {
         self.shape.effort_col(port, k)
     }
 
     /// Column of component `k` of the flow *into the element* at `port`.
     #[must_use]
+    #[inline]
     pub fn flow_col(&self, port: usize, k: usize) -> usize {
         self.shape.flow_col(port, k)
     }
 
     /// Column of component `k` of signal input `i`.
     #[must_use]
+    #[inline]
     pub fn input_col(&self, i: usize, k: usize) -> usize {
         self.shape.input_col(i, k)
     }
 
     /// Column of the element's own state `k`.
     #[must_use]
+    #[inline]
     pub fn state_col(&self, k: usize) -> usize {
         self.shape.state_col(k)
     }
@@ -289,53 +347,60 @@ impl<'a> LocalJacobian<'a> {
     /// # Panics
     /// If the stage does not write `slot`.
     #[must_use]
+    #[inline]
     pub fn row(&self, slot: Slot, k: usize) -> usize {
         self.shape.row(slot, k)
     }
 
     /// Row of the derivative of the element's state `k` (in `derivative_partials`).
     #[must_use]
+    #[inline]
     pub fn derivative_row(&self, k: usize) -> usize {
         debug_assert!(k < self.shape.n_rows, "state {k} of {}", self.shape.n_rows);
         k
     }
 
     /// Set entry (row, col).
+    #[inline]
     pub fn set(&mut self, row: usize, col: usize, v: f64) {
-        let i = row * self.shape.n_cols + col;
-        self.values[i] = v;
-        self.note(row, col, i);
+        match self.position(row, col) {
+            Some(i) => self.values[i] = v,
+            None => self.outside |= v != 0.0,
+        }
     }
 
     /// Add `v` to entry (row, col).
+    #[inline]
     pub fn add(&mut self, row: usize, col: usize, v: f64) {
-        let i = row * self.shape.n_cols + col;
-        self.values[i] += v;
-        self.note(row, col, i);
+        match self.position(row, col) {
+            Some(i) => self.values[i] += v,
+            None => self.outside |= v != 0.0,
+        }
     }
 
-    /// Entry (row, col).
+    /// Entry (row, col) (0 where the block stores nothing).
     #[must_use]
+    #[inline]
     pub fn get(&self, row: usize, col: usize) -> f64 {
-        self.values[row * self.shape.n_cols + col]
+        match &self.index {
+            Index::Dense => self.values[row * self.shape.n_cols + col],
+            Index::Sparse { row_ptr, cols } => {
+                let (a, b) = (row_ptr[row] as usize, row_ptr[row + 1] as usize);
+                cols[a..b]
+                    .binary_search(&(col as u32))
+                    .map_or(0.0, |k| self.values[a + k])
+            }
+            Index::Record(_) => 0.0,
+        }
     }
 
     /// Set every entry to zero.
     pub fn zero(&mut self) {
-        match &mut self.touched {
-            Some(t) => {
-                for &(r, c) in t.list.iter() {
-                    let i = r as usize * self.shape.n_cols + c as usize;
-                    self.values[i] = 0.0;
-                    t.mark[i] = false;
-                }
-                t.list.clear();
-            }
-            None => self.values.fill(0.0),
-        }
+        self.values.fill(0.0);
     }
 
-    /// The values, row-major.
+    /// The values: row-major for a dense block, in structure order (row by row, columns
+    /// sorted) for a sparse one.
     #[must_use]
     pub fn values(&self) -> &[f64] {
         self.values

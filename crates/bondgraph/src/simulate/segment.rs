@@ -33,7 +33,9 @@ pub(super) fn run_segment(
     let cache = RefCell::new(JacCache {
         x: vec![f64::NAN; n],
         t: f64::NAN,
-        jac: nalgebra::DMatrix::zeros(n, n),
+        // sized at the first use: Radau (the default) never asks, and an n×n matrix here
+        // was most of a 2 000-segment pipe's memory
+        jac: nalgebra::DMatrix::zeros(0, 0),
     });
     let rhs = |x: &[f64], _p: &[f64], t: f64, dx: &mut [f64]| {
         rhs_calls.set(rhs_calls.get() + 1);
@@ -47,6 +49,9 @@ pub(super) fn run_segment(
     let jvp = |x: &[f64], _p: &[f64], t: f64, v: &[f64], jv: &mut [f64]| {
         let mut c = cache.borrow_mut();
         let JacCache { x: cx, t: ct, jac } = &mut *c;
+        if jac.nrows() != n {
+            *jac = nalgebra::DMatrix::zeros(n, n);
+        }
         if ct.to_bits() != t.to_bits() || cx.iter().zip(x).any(|(a, b)| a.to_bits() != b.to_bits())
         {
             eqs.jacobian(t, x, jac);

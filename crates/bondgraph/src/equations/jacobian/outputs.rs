@@ -3,7 +3,8 @@
 
 use nalgebra::DMatrix;
 
-use super::{Block, Cell, JacobianWork, Out, EMPTY};
+use super::pass::{write_rows, Pass, Work};
+use super::Out;
 use crate::equations::{Probe, StateEquations};
 
 impl StateEquations {
@@ -50,57 +51,17 @@ impl StateEquations {
         }
         jac.fill(0.0);
         out.fill(0.0);
-        let p = &self.jac_plan;
-        let n_slots = 2 * self.n_bond_values + self.n_signal_values();
-        let mut nominal: Vec<f64> = self.states.iter().map(|s| s.nominal).collect();
-        nominal.resize(width, 1.0);
-        let mut w = JacobianWork {
-            grad: vec![0.0; n_slots * width],
-            range: vec![EMPTY; n_slots],
-            acc: vec![0.0; p.max_rows * width],
-            acc_range: vec![EMPTY; p.max_rows],
-            local: vec![0.0; p.max_local],
-            touched: Vec::with_capacity(p.max_local),
-            mark: vec![false; p.max_local],
-            base: vec![0.0; p.max_rows],
-            plus: vec![0.0; p.max_rows],
-            x: x.to_vec(),
-            dx: vec![0.0; n],
-            nominal,
-        };
+        let code = self.compile(&self.order, seeds, t, x, None);
+        let mut w = Work::new(&code, &self.states);
         let mut ws = self.ws.borrow_mut();
-        let ws = &mut *ws;
-        let mut block = Block {
-            eqs: self,
-            t,
-            n: width,
-            w: &mut w,
-            effort: &mut ws.effort,
-            flow: &mut ws.flow,
-            signals: &mut ws.signals,
-        };
-        for &(id, stage) in &self.order {
-            block.stage(id, stage);
-            for &(g, _, cell) in &p.stages[id][stage].rows {
-                let Cell::Signal(o) = cell else { continue };
-                if let Some(k) = seeds.iter().position(|&s| s == o) {
-                    let c = n + k;
-                    block.w.grad[g * width + c] = 1.0;
-                    block.w.range[g] = (c, c + 1);
-                }
-            }
-        }
-        for (id, l) in self.layouts.iter().enumerate() {
-            if l.n_states > 0 {
-                block.derivatives(id, &mut Out::Dense(jac));
-            }
-        }
+        // compiled at this very point: no element can leave its structure
+        Pass::run(self, &code, &mut w, &mut ws, t, x);
+        write_rows(&code, &w, &mut Out::Dense(jac));
         let nb = self.n_bond_values;
         // Row k += scale · gradient of slot g.
         let add = |out: &mut DMatrix<f64>, k: usize, g: usize, scale: f64| {
-            let (lo, hi) = w.range[g];
-            for j in lo..hi.min(width) {
-                out[(k, j)] += scale * w.grad[g * width + j];
+            for q in code.slots[g].range() {
+                out[(k, code.cols[q] as usize)] += scale * w.g[q];
             }
         };
         for (k, p) in probes.iter().enumerate() {
