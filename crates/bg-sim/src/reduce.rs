@@ -123,6 +123,18 @@ impl ReduceOptions {
     }
 }
 
+/// The worst of scored columns' errors (a NaN counts as worst), shared by the switch search
+/// and `--by activity`.
+#[must_use]
+pub fn worst_of(errors: &[(String, f64)]) -> Option<(&str, f64)> {
+    errors
+        .iter()
+        .fold(None, |w: Option<(&str, f64)>, (n, e)| match w {
+            Some((_, we)) if !(*e > we || e.is_nan()) => w,
+            _ => Some((n.as_str(), *e)),
+        })
+}
+
 /// One scene run and its score.
 #[derive(Clone, Debug)]
 pub struct SceneRun {
@@ -146,12 +158,7 @@ impl SceneRun {
     /// The worst scored column and its error.
     #[must_use]
     pub fn worst(&self) -> Option<(&str, f64)> {
-        self.errors
-            .iter()
-            .fold(None, |w: Option<(&str, f64)>, (n, e)| match w {
-                Some((_, we)) if !(*e > we || e.is_nan()) => w,
-                _ => Some((n.as_str(), *e)),
-            })
+        worst_of(&self.errors)
     }
 
     /// Whether the scene ran and its worst column is within `tol`.

@@ -124,12 +124,7 @@ impl Trial {
     /// The worst scored column and its error.
     #[must_use]
     pub fn worst(&self) -> Option<(&str, f64)> {
-        self.errors
-            .iter()
-            .fold(None, |w: Option<(&str, f64)>, (n, e)| match w {
-                Some((_, we)) if !(*e > we || e.is_nan()) => w,
-                _ => Some((n.as_str(), *e)),
-            })
+        crate::reduce::worst_of(&self.errors)
     }
 
     /// Whether it ran and its worst column is within `tol`.
