@@ -129,3 +129,72 @@ fn a_bad_linear_algebra_is_an_error_at_its_file_line_and_key() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("`Dense!`"), "{}", stderr(&o));
 }
+
+#[test]
+fn linearize_refuses_a_model_above_its_limit_and_summarises_a_large_one() {
+    let dir = tempfile::tempdir().unwrap();
+    // 1 000 segments: 2 002 states, two above the limit of 2 000: refused before any work
+    let big = pipe(dir.path(), 1000, "");
+    let o = bg_sim()
+        .args(["linearize", "--outputs", "vol.p"])
+        .arg(&big)
+        .output()
+        .unwrap();
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    for w in [
+        "pipe1000.toml",
+        "2002 states",
+        "more than the 2000",
+        "dense",
+        "hint:",
+    ] {
+        assert!(err.contains(w), "`{w}` missing: {err}");
+    }
+    // 160 segments (322 states): A, B, C, D and the DC gain, the poles left out with a note,
+    // the matrices summarised in the text
+    let mid = pipe(dir.path(), 160, "");
+    let o = bg_sim()
+        .args(["linearize", "--outputs", "vol.p,line.p[1]"])
+        .arg(&mid)
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(o.status.success(), "{}", stderr(&o));
+    for w in [
+        "322 states",
+        "A = ∂f/∂x (322×322):",
+        "nonzero entries, too many rows or columns to print",
+        "poles: not computed: 322 states, more than the 300",
+        "writes A for an eigen-solver of your own",
+    ] {
+        assert!(out.contains(w), "`{w}` missing: {out}");
+    }
+    let o = bg_sim()
+        .args(["linearize", "--outputs", "vol.p", "--format", "json"])
+        .arg(&mid)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(v["poles"].is_null());
+    assert!(v["poles_note"].as_str().unwrap().contains("322 states"));
+    assert_eq!(v["A"].as_array().unwrap().len(), 322);
+    // a frequency response is refused above its own limit, before any work
+    let o = bg_sim()
+        .args(["linearize", "--outputs", "vol.p", "--bode", "x:vol.p"])
+        .arg(&mid)
+        .output()
+        .unwrap();
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    for w in [
+        "pipe160.toml",
+        "--bode",
+        "322 states",
+        "more than the 300",
+        "hint:",
+    ] {
+        assert!(err.contains(w), "`{w}` missing: {err}");
+    }
+}

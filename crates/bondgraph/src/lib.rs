@@ -117,7 +117,7 @@ pub use equilibrium::{
 pub use error::{CausalityError, Error, GraphError, ParamError, SimulationError};
 pub use graph::{BondGraph, Node};
 pub use kind::{BuildError, Composite, KindDecl, ParamDecl, Params};
-pub use linearize::{linearize, BodePoint, Linearization};
+pub use linearize::{linearize, BodePoint, Linearization, MAX_BODE_STATES, MAX_LINEARIZE_STATES};
 pub use local_jacobian::{LocalJacobian, LocalShape};
 pub use modes::{modes, modes_of, stiffness_ratio, Mode, ModesError, MAX_MODES_STATES};
 /// The dense matrix type of [`StateEquations::jacobian`].

@@ -13,13 +13,27 @@
 //! From (A, B, C, D): the poles (eigenvalues of A, as [`crate::modes`] finds them), the
 //! frequency response G(jω) = C (jωI − A)⁻¹ B + D of one input–output pair (a complex LU per
 //! frequency), Bode data (magnitude in dB, phase in degrees, unwrapped along the
-//! frequencies) and the DC gain G(0) = D − C A⁻¹ B.
+//! frequencies) and the DC gains G(0) = D − C A⁻¹ B (one real LU of A for all pairs).
+//!
+//! # Size
+//! Everything here is dense. [`linearize`] refuses more than [`MAX_LINEARIZE_STATES`] states
+//! before any work; the poles follow [`crate::modes`] and its limit
+//! ([`crate::MAX_MODES_STATES`], the eigen-solver costs about n⁴); a frequency response costs
+//! one complex n×n LU per frequency ([`MAX_BODE_STATES`]).
 
 pub use nalgebra::Complex;
 use nalgebra::{DMatrix, DVector};
 
 use crate::equations::{Probe, StateEquations};
 use crate::modes::ModesError;
+
+/// Most states [`linearize`] takes: A is dense, n² numbers (2 000 states: 4 million, 32 MB,
+/// and as many lines in `bg-sim linearize --format csv`).
+pub const MAX_LINEARIZE_STATES: usize = 2000;
+
+/// Most states of a frequency response ([`Linearization::bode`]): one complex n×n LU per
+/// frequency, ≈ (8/3)n³ flops (300 states: 72 Mflop a frequency, about 10 s for 400).
+pub const MAX_BODE_STATES: usize = 300;
 
 /// (A, B, C, D) with the names of their rows and columns.
 #[derive(Clone, Debug)]
@@ -61,6 +75,7 @@ pub struct BodePoint {
 /// external input's value) for the probes `outputs` (name, probe).
 ///
 /// # Errors
+/// [`ModesError::LinearizeTooLarge`] above [`MAX_LINEARIZE_STATES`] states, before any work;
 /// [`ModesError::NotFinite`] naming the first entry of A, B, C or D that is not finite.
 pub fn linearize(
     eqs: &StateEquations,
@@ -70,6 +85,15 @@ pub fn linearize(
     outputs: &[(String, Probe)],
 ) -> Result<Linearization, ModesError> {
     let n = eqs.n_states();
+    if n > MAX_LINEARIZE_STATES {
+        let limit = MAX_LINEARIZE_STATES;
+        return Err(ModesError::LinearizeTooLarge {
+            n,
+            limit,
+            entries: limit * limit / 1_000_000,
+            mb: limit * limit * 8 / 1_000_000,
+        });
+    }
     let m = inputs.len();
     let seeds: Vec<usize> = inputs.iter().map(|i| i.1).collect();
     let probes: Vec<Probe> = outputs.iter().map(|o| o.1).collect();
@@ -115,8 +139,16 @@ impl Linearization {
     /// Every eigenvalue of A (complex pairs both), fastest (largest |λ|) first.
     ///
     /// # Errors
+    /// [`ModesError::TooLarge`] above [`crate::MAX_MODES_STATES`] states, before any work;
     /// [`ModesError::NoConvergence`] if the eigenvalue iteration fails.
     pub fn poles(&self) -> Result<Vec<Complex<f64>>, ModesError> {
+        let n = self.a.nrows();
+        if n > crate::MAX_MODES_STATES {
+            return Err(ModesError::TooLarge {
+                n,
+                limit: crate::MAX_MODES_STATES,
+            });
+        }
         let mut out = Vec::new();
         for m in crate::modes::modes_of(&self.a)? {
             out.push(m.eigenvalue);
@@ -148,6 +180,19 @@ impl Linearization {
     #[must_use]
     pub fn dc_gain(&self, i: usize, o: usize) -> Option<f64> {
         self.response(i, o, 0.0).map(|g| g.re)
+    }
+
+    /// Every DC gain at once: G(0) = D − C A⁻¹ B, outputs × inputs, from one real LU of A;
+    /// `None` if A is singular (an integrator: the gains are infinite).
+    #[must_use]
+    pub fn dc_gains(&self) -> Option<DMatrix<f64>> {
+        let n = self.a.nrows();
+        if n == 0 {
+            return Some(self.d.clone());
+        }
+        let x = self.a.clone().lu().solve(&self.b)?;
+        let g = &self.d - &self.c * x;
+        g.iter().all(|v| v.is_finite()).then_some(g)
     }
 
     /// Bode data of input `i` to output `o` at the frequencies `f_hz` (ascending), the phase
@@ -250,6 +295,16 @@ mod tests {
         assert_eq!(lin.d[(2, 0)], 0.0, "P = F·v, v = 0 at rest");
         let dc = lin.dc_gain(0, 0).unwrap();
         assert!((dc - 0.01).abs() < 1e-15, "{dc}");
+        // all pairs from one real LU = each pair from its complex solve at ω = 0
+        let all = lin.dc_gains().unwrap();
+        assert_eq!(all.shape(), (3, 1));
+        for o in 0..3 {
+            let one = lin.dc_gain(0, o).unwrap();
+            assert!(
+                (all[(o, 0)] - one).abs() <= 1e-15 * one.abs().max(1.0),
+                "{o}"
+            );
+        }
         let mut worst = 0.0f64;
         for w in [0.1, 1.0, 9.0, 10.0, 99f64.sqrt(), 30.0, 300.0] {
             let g = lin.response(0, 0, w).unwrap();
@@ -286,6 +341,40 @@ mod tests {
             "{}",
             lin1.d[(2, 0)]
         );
+    }
+
+    #[test]
+    fn a_singular_a_has_no_dc_gains_and_the_size_limits_hold() {
+        // a free mass: dp/dt = F, A = 0 (an integrator)
+        let lin = Linearization {
+            t: 0.0,
+            x: vec![0.0],
+            states: vec!["p".into()],
+            inputs: vec!["F".into()],
+            outputs: vec!["p".into()],
+            a: DMatrix::zeros(1, 1),
+            b: DMatrix::from_element(1, 1, 1.0),
+            c: DMatrix::from_element(1, 1, 1.0),
+            d: DMatrix::zeros(1, 1),
+        };
+        assert!(lin.dc_gains().is_none());
+        assert!(lin.dc_gain(0, 0).is_none());
+        // the poles refuse a matrix above the modal analysis' limit, before any work
+        let n = crate::MAX_MODES_STATES + 1;
+        let big = Linearization {
+            a: DMatrix::identity(n, n),
+            b: DMatrix::zeros(n, 0),
+            c: DMatrix::zeros(0, n),
+            d: DMatrix::zeros(0, 0),
+            states: vec![String::new(); n],
+            x: vec![0.0; n],
+            ..lin
+        };
+        assert!(matches!(
+            big.poles(),
+            Err(ModesError::TooLarge { n: k, limit }) if k == n && limit == crate::MAX_MODES_STATES
+        ));
+        assert!(big.dc_gains().is_some());
     }
 
     #[test]

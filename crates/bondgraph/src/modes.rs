@@ -55,6 +55,18 @@ pub enum ModesError {
         /// [`MAX_MODES_STATES`].
         limit: usize,
     },
+    /// More states than [`crate::linearize::MAX_LINEARIZE_STATES`]: A is written dense.
+    #[error("{n} states, more than the {limit} `linearize` takes: A, B, C and D are dense (n² entries of A: {limit} states are {entries} million numbers, {mb} MB, and as many lines of CSV)")]
+    LinearizeTooLarge {
+        /// Number of states.
+        n: usize,
+        /// [`crate::linearize::MAX_LINEARIZE_STATES`].
+        limit: usize,
+        /// limit², in millions (for the message).
+        entries: usize,
+        /// limit² × 8 bytes, in MB (for the message).
+        mb: usize,
+    },
     /// The eigenvalue iteration did not converge.
     #[error("the eigenvalues of the {n}×{n} Jacobian did not converge")]
     NoConvergence {

@@ -127,6 +127,29 @@ pub fn command(a: &Args) -> ExitCode {
             return ExitCode::from(BAD_INPUT);
         }
     };
+    // Before any work (the run to --at included): everything here is dense.
+    let n = model.equations.n_states();
+    if n > bondgraph::MAX_LINEARIZE_STATES {
+        tell!(
+            "error: {}: {}\n  hint: linearise a smaller variant of the model (fewer segments of a line, fewer modes per link: --set, or the cheaper scenes of `bg-sim reduce`)",
+            model.file(),
+            bondgraph::ModesError::LinearizeTooLarge {
+                n,
+                limit: bondgraph::MAX_LINEARIZE_STATES,
+                entries: bondgraph::MAX_LINEARIZE_STATES.pow(2) / 1_000_000,
+                mb: bondgraph::MAX_LINEARIZE_STATES.pow(2) * 8 / 1_000_000,
+            }
+        );
+        return ExitCode::from(BAD_INPUT);
+    }
+    if a.bode.is_some() && n > bondgraph::MAX_BODE_STATES {
+        tell!(
+            "error: {}: --bode: {n} states, more than the {} a frequency response takes (one dense complex LU per frequency, ≈ (8/3)n³ flops each)\n  hint: --format csv writes A, B, C and D for a tool of your own, or take a smaller variant of the model (--set)",
+            model.file(),
+            bondgraph::MAX_BODE_STATES
+        );
+        return ExitCode::from(BAD_INPUT);
+    }
     if let Err(e) = model.check_linear_names(&inputs, &outputs) {
         tell!("error: {e}");
         return ExitCode::from(BAD_INPUT);
@@ -149,8 +172,10 @@ pub fn command(a: &Args) -> ExitCode {
             return ExitCode::from(FAILED);
         }
     };
+    // Above the modal analysis' size the poles are left out, with a note.
     let poles = match lin.poles() {
-        Ok(p) => p,
+        Ok(p) => Some(p),
+        Err(bondgraph::ModesError::TooLarge { .. }) => None,
         Err(e) => {
             tell!("error: {e}");
             return ExitCode::from(FAILED);
@@ -167,6 +192,7 @@ pub fn command(a: &Args) -> ExitCode {
     if let (Some(path), Some((i, o, pts))) = (&a.plot, &bode) {
         let marks: Vec<f64> = poles
             .iter()
+            .flatten()
             .filter(|p| p.im >= 0.0)
             .map(|p| p.norm() / (2.0 * std::f64::consts::PI))
             .collect();
@@ -183,8 +209,8 @@ pub fn command(a: &Args) -> ExitCode {
         }
     }
     let text = match format {
-        Format::Text => text(&title, &lin, &poles, bode.as_ref()),
-        Format::Json => json(&lin, &poles, bode.as_ref()),
+        Format::Text => text(&title, &lin, poles.as_deref(), bode.as_ref()),
+        Format::Json => json(&lin, poles.as_deref(), bode.as_ref()),
         Format::Csv => csv(&lin, bode.as_ref()),
     };
     say!("{text}");
@@ -192,6 +218,18 @@ pub fn command(a: &Args) -> ExitCode {
 }
 
 type Bode = (usize, usize, Vec<BodePoint>);
+
+/// Most rows or columns a matrix is printed with in the text format; a larger one is
+/// summarised (`--format csv` or `json` give every entry).
+const MAX_PRINTED: usize = 60;
+
+/// Why the poles are left out above the modal analysis' size.
+fn poles_note(n: usize) -> String {
+    format!(
+        "not computed: {n} states, more than the {} the dense eigen-solver takes (about n⁴); `--format csv` writes A for an eigen-solver of your own",
+        bondgraph::MAX_MODES_STATES
+    )
+}
 
 fn matrix(
     out: &mut String,
@@ -202,6 +240,14 @@ fn matrix(
 ) {
     let _ = writeln!(out, "{name} ({}×{}):", m.nrows(), m.ncols());
     if m.nrows() == 0 || m.ncols() == 0 {
+        return;
+    }
+    if m.nrows() > MAX_PRINTED || m.ncols() > MAX_PRINTED {
+        let nonzero = m.iter().filter(|v| **v != 0.0).count();
+        let _ = writeln!(
+            out,
+            "  {nonzero} nonzero entries, too many rows or columns to print here (more than {MAX_PRINTED}): --format csv or json gives every entry"
+        );
         return;
     }
     let w = rows.iter().map(|r| r.chars().count()).max().unwrap_or(0);
@@ -228,7 +274,12 @@ fn clip(s: &str, n: usize) -> String {
     }
 }
 
-fn text(title: &str, lin: &Linearization, poles: &[Complex<f64>], bode: Option<&Bode>) -> String {
+fn text(
+    title: &str,
+    lin: &Linearization,
+    poles: Option<&[Complex<f64>]>,
+    bode: Option<&Bode>,
+) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
@@ -243,17 +294,25 @@ fn text(title: &str, lin: &Linearization, poles: &[Complex<f64>], bode: Option<&
     matrix(&mut out, "B = ∂f/∂u", &lin.b, &states, &lin.inputs);
     matrix(&mut out, "C = ∂y/∂x", &lin.c, &lin.outputs, &lin.states);
     matrix(&mut out, "D = ∂y/∂u", &lin.d, &lin.outputs, &lin.inputs);
-    let _ = writeln!(out, "poles (1/s), fastest first:");
-    for p in poles {
-        let _ = writeln!(out, "  {}", pole(*p));
+    match poles {
+        Some(poles) => {
+            let _ = writeln!(out, "poles (1/s), fastest first:");
+            for p in poles {
+                let _ = writeln!(out, "  {}", pole(*p));
+            }
+        }
+        None => {
+            let _ = writeln!(out, "poles: {}", poles_note(lin.states.len()));
+        }
     }
     if !lin.inputs.is_empty() && !lin.outputs.is_empty() {
         let _ = writeln!(out, "DC gains G(0) = D − C A⁻¹ B:");
+        let gains = lin.dc_gains();
         for (o, on) in lin.outputs.iter().enumerate() {
             for (i, inn) in lin.inputs.iter().enumerate() {
-                let g = lin.dc_gain(i, o).map_or_else(
+                let g = gains.as_ref().map_or_else(
                     || "infinite (A is singular)".to_owned(),
-                    |g| format!("{g:.9e}"),
+                    |g| format!("{:.9e}", g[(o, i)]),
                 );
                 let _ = writeln!(out, "  {inn} → {on}: {g}");
             }
@@ -315,9 +374,14 @@ fn rows_json(m: &bondgraph::DMatrix<f64>) -> serde_json::Value {
     )
 }
 
-fn json(lin: &Linearization, poles: &[Complex<f64>], bode: Option<&Bode>) -> String {
+fn json(lin: &Linearization, poles: Option<&[Complex<f64>]>, bode: Option<&Bode>) -> String {
+    let gains = lin.dc_gains();
     let dc: Vec<Vec<Option<f64>>> = (0..lin.outputs.len())
-        .map(|o| (0..lin.inputs.len()).map(|i| lin.dc_gain(i, o)).collect())
+        .map(|o| {
+            (0..lin.inputs.len())
+                .map(|i| gains.as_ref().map(|g| g[(o, i)]))
+                .collect()
+        })
         .collect();
     let mut v = serde_json::json!({
         "t": lin.t,
@@ -329,9 +393,12 @@ fn json(lin: &Linearization, poles: &[Complex<f64>], bode: Option<&Bode>) -> Str
         "B": rows_json(&lin.b),
         "C": rows_json(&lin.c),
         "D": rows_json(&lin.d),
-        "poles": poles.iter().map(|p| serde_json::json!({"re": p.re, "im": p.im})).collect::<Vec<_>>(),
+        "poles": poles.map(|poles| poles.iter().map(|p| serde_json::json!({"re": p.re, "im": p.im})).collect::<Vec<_>>()),
         "dc_gain": dc,
     });
+    if poles.is_none() {
+        v["poles_note"] = serde_json::json!(poles_note(lin.states.len()));
+    }
     if let Some((i, o, pts)) = bode {
         v["bode"] = serde_json::json!({
             "input": lin.inputs[*i],
