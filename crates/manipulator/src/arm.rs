@@ -217,6 +217,7 @@ impl PlanarArm {
             cs: Vec::with_capacity(nl),
             origin: Vec::with_capacity(nl + 1),
             shift: Vec::with_capacity(nl + 1),
+            chord: Vec::with_capacity(nl * (nl + 1) / 2),
         }
     }
 
@@ -262,6 +263,7 @@ impl PlanarArm {
         f.cs.clear();
         f.origin.clear();
         f.shift.clear();
+        f.chord.clear();
         let (mut a, mut o, mut shift) = (0.0, Vector2::zeros(), Vector2::zeros());
         for (i, link) in self.links.iter().enumerate() {
             a += q[i];
@@ -290,6 +292,13 @@ impl PlanarArm {
         if self.stiffening {
             f.shift.push(shift);
         }
+        // c_ij = R_0^i (o_i − o_j) for j ≤ i, row by row
+        for (i, &(c, s)) in f.cs.iter().enumerate() {
+            for j in 0..=i {
+                let d = f.origin[i] - f.origin[j];
+                f.chord.push(Vector2::new(c * d.x + s * d.y, -s * d.x + c * d.y));
+            }
+        }
     }
 }
 
@@ -304,6 +313,8 @@ pub struct Frames {
     /// With geometric stiffening: `o'_i − o_i = Σ_{j<i} s_j e_j`, the displacement of joint i
     /// by the shortening of the chords before it; else empty.
     shift: Vec<Vector2<f64>>,
+    /// The chord offsets `c_j = R_0^i (o_i − o_j)`, j ≤ i, at `i (i + 1) / 2 + j`.
+    chord: Vec<Vector2<f64>>,
 }
 
 /// The arm at one configuration q: chord angles, joint positions, deflections.
@@ -424,8 +435,13 @@ impl<'a> Pose<'a> {
     /// (zero for j = i). The moment arm of a point r of link i about joint j is
     /// `d_j = c_j + (x, w)` (eq. 35).
     #[must_use]
+    #[inline]
     pub fn chord_offset(&self, i: usize, j: usize) -> Vector2<f64> {
-        self.to_frame(i, &(self.frames.origin[i] - self.frames.origin[j]))
+        if j <= i {
+            self.frames.chord[i * (i + 1) / 2 + j]
+        } else {
+            self.to_frame(i, &(self.frames.origin[i] - self.frames.origin[j]))
+        }
     }
     /// The non-zero columns of the velocity Jacobian `∂r/∂q` of a station in frame 0 (rows
     /// `N_c` of eq. 72–73): `ẑ × (r − o_j)` for the joints j ≤ i of its link i, then

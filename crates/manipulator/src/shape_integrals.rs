@@ -52,6 +52,20 @@ pub struct ShapeIntegrals {
     bending: DMatrix<f64>,
     /// With geometric stiffening: the integrals of the shortening.
     shortening: Option<ShorteningIntegrals>,
+    /// Entries of G_A and G_I read per evaluation, laid out for it (see [`Self::finish`]).
+    fast: FastEntries,
+}
+
+/// The invariants the right-hand side reads on every evaluation, copied out of G_A and G_I
+/// once so that the loops run over contiguous memory (the same numbers, bit for bit).
+#[derive(Clone, Debug, Default, PartialEq)]
+struct FastEntries {
+    /// `[a_k, b_k, ∫ρI θ_k]` per mode k.
+    joint_mode: Vec<[f64; 3]>,
+    /// `P_kl` at `k m + l`.
+    products: Vec<f64>,
+    /// The modes' block of M, `0 + (P_kl + ∫ρI θ_k θ_l)`, column-major m × m.
+    modal_mass: Vec<f64>,
 }
 
 /// The ρA-weighted moments of a link's deflection at (q, u) that the dynamics need:
@@ -95,6 +109,7 @@ impl ShapeIntegrals {
             rotation: DMatrix::zeros(m + 1, m + 1),
             bending: DMatrix::zeros(m, m),
             shortening: None,
+            fast: FastEntries::default(),
         };
         let sines: Option<Vec<f64>> = if link.is_uniform() {
             link.modes().iter().map(|p| p.sine_wavenumber()).collect()
@@ -117,7 +132,36 @@ impl ShapeIntegrals {
         if link.geometric_stiffening() {
             s.shortening = Some(ShorteningIntegrals::of(link, points)?);
         }
+        s.finish();
         Ok(s)
+    }
+
+    /// Copy the entries of [`FastEntries`] out of the finished G_A and G_I.
+    fn finish(&mut self) {
+        let m = self.n_modes();
+        self.fast = FastEntries {
+            joint_mode: (0..m)
+                .map(|k| [self.mode_mass(k), self.mode_moment(k), self.rotary_mode(k)])
+                .collect(),
+            products: (0..m * m)
+                .map(|kl| self.mode_product(kl / m, kl % m))
+                .collect(),
+            modal_mass: (0..m * m)
+                .map(|lk| {
+                    let (l, k) = (lk / m, lk % m);
+                    0.0 + (self.mode_product(k, l) + self.rotary_product(k, l))
+                })
+                .collect(),
+        };
+    }
+
+    /// `[a_k, b_k, ∫ρI θ_k]` per mode k: the constants of the joint–mode entries of M.
+    pub(crate) fn joint_mode_constants(&self) -> &[[f64; 3]] {
+        &self.fast.joint_mode
+    }
+    /// The modes' own block of M, `0 + (P_kl + ∫ρI θ_k θ_l)`, column-major m × m.
+    pub(crate) fn modal_mass(&self) -> &[f64] {
+        &self.fast.modal_mass
     }
 
     fn add_sines(&mut self, link: &Link, kappa: &[f64]) {
@@ -236,14 +280,21 @@ impl ShapeIntegrals {
     /// The moments of the deflection with modal coordinates `q` and speeds `u` (m each).
     pub(crate) fn deflection_moments(&self, q: &[f64], u: &[f64]) -> DeflectionMoments {
         let mut d = DeflectionMoments::default();
-        for k in 0..q.len() {
+        let (m, nm) = (q.len(), self.n_modes());
+        let (q, u) = (&q[..m], &u[..m]);
+        for (k, (row, c)) in self
+            .fast
+            .products
+            .chunks_exact(nm.max(1))
+            .zip(&self.fast.joint_mode)
+            .enumerate()
+        {
             let (mut pq, mut pu) = (0.0, 0.0);
-            for l in 0..q.len() {
-                let p = self.mode_product(k, l);
-                pq += p * q[l];
-                pu += p * u[l];
+            for ((p, ql), ul) in row[..m].iter().zip(q).zip(u) {
+                pq += p * ql;
+                pu += p * ul;
             }
-            let (a, b) = (self.mode_mass(k), self.mode_moment(k));
+            let (a, b) = (c[0], c[1]);
             d.w += a * q[k];
             d.w_dot += a * u[k];
             d.x_w_dot += b * u[k];
@@ -256,9 +307,11 @@ impl ShapeIntegrals {
 
     /// `(Pq)_k = ∫ρA ψ_k w`.
     pub(crate) fn mode_times_deflection(&self, k: usize, q: &[f64]) -> f64 {
-        q.iter()
-            .enumerate()
-            .map(|(l, ql)| self.mode_product(k, l) * ql)
+        let nm = self.n_modes();
+        self.fast.products[k * nm..k * nm + q.len()]
+            .iter()
+            .zip(q)
+            .map(|(p, ql)| p * ql)
             .sum()
     }
 }
