@@ -12,6 +12,7 @@
 //! i's chord at the angle `φ_i = q_1 + … + q_i` from x₀.
 
 use std::borrow::Cow;
+use std::cell::RefCell;
 
 use nalgebra::Vector2;
 
@@ -50,6 +51,17 @@ pub struct PlanarArm {
     outboard: Vec<f64>,
     /// Whether any link keeps its axial shortening.
     stiffening: bool,
+    /// The frames at the last configuration asked for with [`pose_in`](Self::pose_in): the
+    /// elements of one arm all read the same q, so one of them computes them, the others copy.
+    shared: RefCell<SharedFrames>,
+}
+
+/// [`Frames`] and the configuration they are at (compared bit for bit).
+#[derive(Clone, Debug)]
+struct SharedFrames {
+    q: Vec<f64>,
+    valid: bool,
+    frames: Frames,
 }
 
 impl PlanarArm {
@@ -95,7 +107,7 @@ impl PlanarArm {
             .map(|i| links[i + 1..].iter().map(Link::mass).sum())
             .collect();
         let stiffening = links.iter().any(Link::geometric_stiffening);
-        Ok(Self {
+        let mut arm = Self {
             links,
             joint: RevoluteJoint,
             gravity,
@@ -105,7 +117,18 @@ impl PlanarArm {
             integrals,
             outboard,
             stiffening,
-        })
+            shared: RefCell::new(SharedFrames {
+                q: Vec::new(),
+                valid: false,
+                frames: Frames::default(),
+            }),
+        };
+        arm.shared = RefCell::new(SharedFrames {
+            q: Vec::with_capacity(n),
+            valid: false,
+            frames: arm.frames(),
+        });
+        Ok(arm)
     }
 
     /// Number of generalized coordinates n.
@@ -243,12 +266,35 @@ impl PlanarArm {
     /// If `q.len() != self.n()`.
     #[must_use]
     pub fn pose_in<'a>(&'a self, q: &'a [f64], frames: &'a mut Frames) -> Pose<'a> {
-        self.fill(q, frames);
+        self.fill_shared(q, frames);
         Pose {
             arm: self,
             q,
             frames: Cow::Borrowed(frames),
         }
+    }
+
+    /// The frames at q into `f`: copied from the shared ones if they are at q (bit for bit),
+    /// else computed there first. The same numbers as [`fill`](Self::fill), without
+    /// allocating once `f` has room.
+    fn fill_shared(&self, q: &[f64], f: &mut Frames) {
+        let mut shared = self.shared.borrow_mut();
+        let SharedFrames {
+            q: at,
+            valid,
+            frames,
+        } = &mut *shared;
+        let same = *valid
+            && at.len() == q.len()
+            && at.iter().zip(q).all(|(a, b)| a.to_bits() == b.to_bits());
+        if !same {
+            *valid = false;
+            self.fill(q, frames);
+            at.clear();
+            at.extend_from_slice(q);
+            *valid = true;
+        }
+        f.copy_from(frames);
     }
 
     fn fill(&self, q: &[f64], f: &mut Frames) {
@@ -315,6 +361,17 @@ pub struct Frames {
     shift: Vec<Vector2<f64>>,
     /// The chord offsets `c_j = R_0^i (o_i − o_j)`, j ≤ i, at `i (i + 1) / 2 + j`.
     chord: Vec<Vector2<f64>>,
+}
+
+impl Frames {
+    /// `self ← other` in the buffers already allocated (no allocation once they have room).
+    fn copy_from(&mut self, other: &Self) {
+        self.phi.clone_from(&other.phi);
+        self.cs.clone_from(&other.cs);
+        self.origin.clone_from(&other.origin);
+        self.shift.clone_from(&other.shift);
+        self.chord.clone_from(&other.chord);
+    }
 }
 
 /// The arm at one configuration q: chord angles, joint positions, deflections.

@@ -36,10 +36,10 @@ impl Cholesky {
         let n = self.n;
         assert_eq!(m.shape(), (n, n), "matrix of another size");
         self.ok = false;
-        for (j, m_j) in m.as_slice().chunks_exact(n.max(1)).enumerate() {
+        for j in 0..n {
             let tail = &mut self.u[j * n..];
             let col_j = &mut tail[..n];
-            let d = m_j[j] - dot(&col_j[..j], &col_j[..j]);
+            let d = m[(j, j)] - dot(&col_j[..j], &col_j[..j]);
             if !(d > 0.0 && d.is_finite()) {
                 return false;
             }
@@ -51,7 +51,7 @@ impl Cholesky {
             for i in j + 1..n {
                 let (left, right) = tail.split_at_mut((i - j) * n);
                 let s = dot(&right[..j], &left[..j]);
-                right[j] = (m_j[i] - s) * inv;
+                right[j] = (m[(i, j)] - s) * inv;
             }
         }
         self.ok = true;

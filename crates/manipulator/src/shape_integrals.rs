@@ -62,8 +62,6 @@ pub struct ShapeIntegrals {
 struct FastEntries {
     /// `[a_k, b_k, ∫ρI θ_k]` per mode k.
     joint_mode: Vec<[f64; 3]>,
-    /// `P_kl` at `k m + l`.
-    products: Vec<f64>,
     /// The modes' block of M, `0 + (P_kl + ∫ρI θ_k θ_l)`, column-major m × m.
     modal_mass: Vec<f64>,
 }
@@ -142,9 +140,6 @@ impl ShapeIntegrals {
         self.fast = FastEntries {
             joint_mode: (0..m)
                 .map(|k| [self.mode_mass(k), self.mode_moment(k), self.rotary_mode(k)])
-                .collect(),
-            products: (0..m * m)
-                .map(|kl| self.mode_product(kl / m, kl % m))
                 .collect(),
             modal_mass: (0..m * m)
                 .map(|lk| {
@@ -280,21 +275,14 @@ impl ShapeIntegrals {
     /// The moments of the deflection with modal coordinates `q` and speeds `u` (m each).
     pub(crate) fn deflection_moments(&self, q: &[f64], u: &[f64]) -> DeflectionMoments {
         let mut d = DeflectionMoments::default();
-        let (m, nm) = (q.len(), self.n_modes());
-        let (q, u) = (&q[..m], &u[..m]);
-        for (k, (row, c)) in self
-            .fast
-            .products
-            .chunks_exact(nm.max(1))
-            .zip(&self.fast.joint_mode)
-            .enumerate()
-        {
+        for k in 0..q.len() {
             let (mut pq, mut pu) = (0.0, 0.0);
-            for ((p, ql), ul) in row[..m].iter().zip(q).zip(u) {
-                pq += p * ql;
-                pu += p * ul;
+            for l in 0..q.len() {
+                let p = self.mode_product(k, l);
+                pq += p * q[l];
+                pu += p * u[l];
             }
-            let (a, b) = (c[0], c[1]);
+            let (a, b) = (self.mode_mass(k), self.mode_moment(k));
             d.w += a * q[k];
             d.w_dot += a * u[k];
             d.x_w_dot += b * u[k];
@@ -307,11 +295,9 @@ impl ShapeIntegrals {
 
     /// `(Pq)_k = ∫ρA ψ_k w`.
     pub(crate) fn mode_times_deflection(&self, k: usize, q: &[f64]) -> f64 {
-        let nm = self.n_modes();
-        self.fast.products[k * nm..k * nm + q.len()]
-            .iter()
-            .zip(q)
-            .map(|(p, ql)| p * ql)
+        q.iter()
+            .enumerate()
+            .map(|(l, ql)| self.mode_product(k, l) * ql)
             .sum()
     }
 }
