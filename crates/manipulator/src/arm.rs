@@ -342,7 +342,8 @@ impl PlanarArm {
         for (i, &(c, s)) in f.cs.iter().enumerate() {
             for j in 0..=i {
                 let d = f.origin[i] - f.origin[j];
-                f.chord.push(Vector2::new(c * d.x + s * d.y, -s * d.x + c * d.y));
+                f.chord
+                    .push(Vector2::new(c * d.x + s * d.y, -s * d.x + c * d.y));
             }
         }
     }

@@ -122,7 +122,10 @@ mod tests {
             full[k] = 1.0;
             c.solve_in_place(&mut full);
             c.inverse_column(k, &mut short);
-            assert!(full.iter().zip(&short).all(|(a, b)| a.to_bits() == b.to_bits()));
+            assert!(full
+                .iter()
+                .zip(&short)
+                .all(|(a, b)| a.to_bits() == b.to_bits()));
         }
         let mut bad = m.clone();
         bad[(2, 2)] = -1.0;
