@@ -107,7 +107,12 @@ impl PlanarArm {
             .map(|i| links[i + 1..].iter().map(Link::mass).sum())
             .collect();
         let stiffening = links.iter().any(Link::geometric_stiffening);
-        let mut arm = Self {
+        let shared = RefCell::new(SharedFrames {
+            q: Vec::with_capacity(n),
+            valid: false,
+            frames: Frames::with_room(links.len()),
+        });
+        Ok(Self {
             links,
             joint: RevoluteJoint,
             gravity,
@@ -117,18 +122,8 @@ impl PlanarArm {
             integrals,
             outboard,
             stiffening,
-            shared: RefCell::new(SharedFrames {
-                q: Vec::new(),
-                valid: false,
-                frames: Frames::default(),
-            }),
-        };
-        arm.shared = RefCell::new(SharedFrames {
-            q: Vec::with_capacity(n),
-            valid: false,
-            frames: arm.frames(),
-        });
-        Ok(arm)
+            shared,
+        })
     }
 
     /// Number of generalized coordinates n.
@@ -234,14 +229,7 @@ impl PlanarArm {
     /// Frames with room for this arm's links (for [`pose_in`](Self::pose_in)).
     #[must_use]
     pub fn frames(&self) -> Frames {
-        let nl = self.links.len();
-        Frames {
-            phi: Vec::with_capacity(nl),
-            cs: Vec::with_capacity(nl),
-            origin: Vec::with_capacity(nl + 1),
-            shift: Vec::with_capacity(nl + 1),
-            chord: Vec::with_capacity(nl * (nl + 1) / 2),
-        }
+        Frames::with_room(self.links.len())
     }
 
     /// The configuration at `q`.
@@ -365,6 +353,17 @@ pub struct Frames {
 }
 
 impl Frames {
+    /// Room for `nl` links.
+    fn with_room(nl: usize) -> Self {
+        Self {
+            phi: Vec::with_capacity(nl),
+            cs: Vec::with_capacity(nl),
+            origin: Vec::with_capacity(nl + 1),
+            shift: Vec::with_capacity(nl + 1),
+            chord: Vec::with_capacity(nl * (nl + 1) / 2),
+        }
+    }
+
     /// `self ← other` in the buffers already allocated (no allocation once they have room).
     fn copy_from(&mut self, other: &Self) {
         self.phi.clone_from(&other.phi);
@@ -570,5 +569,19 @@ mod tests {
         assert!((pose.chord_angle(2) + pi / 2.0).abs() < 1e-12);
         assert!(arm.station(3, 1.0).is_err());
         assert!(arm.station(0, 10.5).is_err());
+        // the frames shared by the arm's elements: the same bits as computed afresh, whatever
+        // the order of the configurations asked for
+        let q2: Vec<f64> = q.iter().map(|v| v + 0.3).collect();
+        let mut frames = [arm.frames(), arm.frames()];
+        for (k, qa) in [&q[..], &q2[..], &q[..]].into_iter().enumerate() {
+            let (shared, fresh) = (arm.pose_in(qa, &mut frames[k % 2]), arm.pose(qa));
+            assert_eq!(shared.frames.as_ref(), fresh.frames.as_ref());
+            assert_eq!(shared.chord_offset(2, 0), pose_chord(&fresh, 2, 0));
+        }
+    }
+
+    /// `c_j` computed directly.
+    fn pose_chord(p: &Pose<'_>, i: usize, j: usize) -> Vector2<f64> {
+        p.to_frame(i, &(p.origin(i) - p.origin(j)))
     }
 }
