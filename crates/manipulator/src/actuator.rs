@@ -96,28 +96,29 @@ impl Pose<'_> {
     /// a column of τ_b (eqs. 66–68), without allocating. A joint that turns both pins turns
     /// the actuator as a whole and leaves its length alone: its entry is exactly zero.
     pub fn actuator_length(&self, a: &PinPoint, b: &PinPoint, gradient: &mut [f64]) -> f64 {
-        let d = self.pin_point_position(b) - self.pin_point_position(a);
+        let (ra, rb) = (self.pin_point_position(a), self.pin_point_position(b));
+        let d = rb - ra;
         let l = d.norm();
         let e = d / l;
         gradient.fill(0.0);
         for (j, g) in gradient.iter_mut().enumerate().take(self.arm().n_links()) {
             if !(turns(a, j) && turns(b, j)) {
-                *g = e.dot(&self.pin_pair_joint_column(a, b, j));
+                *g = e.dot(&self.pin_pair_joint_column(a, b, (&ra, &rb), j));
             }
         }
         self.pin_pair_mode_columns(a, b, |k, col| gradient[k] += e.dot(&col));
         l
     }
 
-    /// `∂(r_b − r_a)/∂q_j` for joint j: `ẑ × (r_b − r_a)` if it turns both pins, else the
-    /// motion of the one it turns.
+    /// `∂(r_b − r_a)/∂q_j` for joint j, with the pins at `(r_a, r_b)`: `ẑ × (r_b − r_a)` if it
+    /// turns both pins, else the motion of the one it turns.
     pub(crate) fn pin_pair_joint_column(
         &self,
         a: &PinPoint,
         b: &PinPoint,
+        (ra, rb): (&Vector2<f64>, &Vector2<f64>),
         j: usize,
     ) -> Vector2<f64> {
-        let (ra, rb) = (self.pin_point_position(a), self.pin_point_position(b));
         let o = self.pivot(j);
         match (turns(a, j), turns(b, j)) {
             (true, true) => z_cross(&(rb - ra)),

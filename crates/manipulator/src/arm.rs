@@ -12,6 +12,7 @@
 //! i's chord at the angle `φ_i = q_1 + … + q_i` from x₀.
 
 use std::borrow::Cow;
+use std::cell::RefCell;
 
 use nalgebra::Vector2;
 
@@ -50,6 +51,17 @@ pub struct PlanarArm {
     outboard: Vec<f64>,
     /// Whether any link keeps its axial shortening.
     stiffening: bool,
+    /// The frames at the last configuration asked for with [`pose_in`](Self::pose_in): the
+    /// elements of one arm all read the same q, so one of them computes them, the others copy.
+    shared: RefCell<SharedFrames>,
+}
+
+/// [`Frames`] and the configuration they are at (compared bit for bit).
+#[derive(Clone, Debug)]
+struct SharedFrames {
+    q: Vec<f64>,
+    valid: bool,
+    frames: Frames,
 }
 
 impl PlanarArm {
@@ -95,6 +107,11 @@ impl PlanarArm {
             .map(|i| links[i + 1..].iter().map(Link::mass).sum())
             .collect();
         let stiffening = links.iter().any(Link::geometric_stiffening);
+        let shared = RefCell::new(SharedFrames {
+            q: Vec::with_capacity(n),
+            valid: false,
+            frames: Frames::with_room(links.len()),
+        });
         Ok(Self {
             links,
             joint: RevoluteJoint,
@@ -105,6 +122,7 @@ impl PlanarArm {
             integrals,
             outboard,
             stiffening,
+            shared,
         })
     }
 
@@ -211,13 +229,7 @@ impl PlanarArm {
     /// Frames with room for this arm's links (for [`pose_in`](Self::pose_in)).
     #[must_use]
     pub fn frames(&self) -> Frames {
-        let nl = self.links.len();
-        Frames {
-            phi: Vec::with_capacity(nl),
-            cs: Vec::with_capacity(nl),
-            origin: Vec::with_capacity(nl + 1),
-            shift: Vec::with_capacity(nl + 1),
-        }
+        Frames::with_room(self.links.len())
     }
 
     /// The configuration at `q`.
@@ -242,12 +254,35 @@ impl PlanarArm {
     /// If `q.len() != self.n()`.
     #[must_use]
     pub fn pose_in<'a>(&'a self, q: &'a [f64], frames: &'a mut Frames) -> Pose<'a> {
-        self.fill(q, frames);
+        self.fill_shared(q, frames);
         Pose {
             arm: self,
             q,
             frames: Cow::Borrowed(frames),
         }
+    }
+
+    /// The frames at q into `f`: copied from the shared ones if they are at q (bit for bit),
+    /// else computed there first. The same numbers as [`fill`](Self::fill), without
+    /// allocating once `f` has room.
+    fn fill_shared(&self, q: &[f64], f: &mut Frames) {
+        let mut shared = self.shared.borrow_mut();
+        let SharedFrames {
+            q: at,
+            valid,
+            frames,
+        } = &mut *shared;
+        let same = *valid
+            && at.len() == q.len()
+            && at.iter().zip(q).all(|(a, b)| a.to_bits() == b.to_bits());
+        if !same {
+            *valid = false;
+            self.fill(q, frames);
+            at.clear();
+            at.extend_from_slice(q);
+            *valid = true;
+        }
+        f.copy_from(frames);
     }
 
     fn fill(&self, q: &[f64], f: &mut Frames) {
@@ -262,6 +297,7 @@ impl PlanarArm {
         f.cs.clear();
         f.origin.clear();
         f.shift.clear();
+        f.chord.clear();
         let (mut a, mut o, mut shift) = (0.0, Vector2::zeros(), Vector2::zeros());
         for (i, link) in self.links.iter().enumerate() {
             a += q[i];
@@ -290,6 +326,14 @@ impl PlanarArm {
         if self.stiffening {
             f.shift.push(shift);
         }
+        // c_ij = R_0^i (o_i − o_j) for j ≤ i, row by row
+        for (i, &(c, s)) in f.cs.iter().enumerate() {
+            for j in 0..=i {
+                let d = f.origin[i] - f.origin[j];
+                f.chord
+                    .push(Vector2::new(c * d.x + s * d.y, -s * d.x + c * d.y));
+            }
+        }
     }
 }
 
@@ -304,6 +348,30 @@ pub struct Frames {
     /// With geometric stiffening: `o'_i − o_i = Σ_{j<i} s_j e_j`, the displacement of joint i
     /// by the shortening of the chords before it; else empty.
     shift: Vec<Vector2<f64>>,
+    /// The chord offsets `c_j = R_0^i (o_i − o_j)`, j ≤ i, at `i (i + 1) / 2 + j`.
+    chord: Vec<Vector2<f64>>,
+}
+
+impl Frames {
+    /// Room for `nl` links.
+    fn with_room(nl: usize) -> Self {
+        Self {
+            phi: Vec::with_capacity(nl),
+            cs: Vec::with_capacity(nl),
+            origin: Vec::with_capacity(nl + 1),
+            shift: Vec::with_capacity(nl + 1),
+            chord: Vec::with_capacity(nl * (nl + 1) / 2),
+        }
+    }
+
+    /// `self ← other` in the buffers already allocated (no allocation once they have room).
+    fn copy_from(&mut self, other: &Self) {
+        self.phi.clone_from(&other.phi);
+        self.cs.clone_from(&other.cs);
+        self.origin.clone_from(&other.origin);
+        self.shift.clone_from(&other.shift);
+        self.chord.clone_from(&other.chord);
+    }
 }
 
 /// The arm at one configuration q: chord angles, joint positions, deflections.
@@ -424,8 +492,13 @@ impl<'a> Pose<'a> {
     /// (zero for j = i). The moment arm of a point r of link i about joint j is
     /// `d_j = c_j + (x, w)` (eq. 35).
     #[must_use]
+    #[inline]
     pub fn chord_offset(&self, i: usize, j: usize) -> Vector2<f64> {
-        self.to_frame(i, &(self.frames.origin[i] - self.frames.origin[j]))
+        if j <= i {
+            self.frames.chord[i * (i + 1) / 2 + j]
+        } else {
+            self.to_frame(i, &(self.frames.origin[i] - self.frames.origin[j]))
+        }
     }
     /// The non-zero columns of the velocity Jacobian `∂r/∂q` of a station in frame 0 (rows
     /// `N_c` of eq. 72–73): `ẑ × (r − o_j)` for the joints j ≤ i of its link i, then
@@ -496,5 +569,19 @@ mod tests {
         assert!((pose.chord_angle(2) + pi / 2.0).abs() < 1e-12);
         assert!(arm.station(3, 1.0).is_err());
         assert!(arm.station(0, 10.5).is_err());
+        // the frames shared by the arm's elements: the same bits as computed afresh, whatever
+        // the order of the configurations asked for
+        let q2: Vec<f64> = q.iter().map(|v| v + 0.3).collect();
+        let mut frames = [arm.frames(), arm.frames()];
+        for (k, qa) in [&q[..], &q2[..], &q[..]].into_iter().enumerate() {
+            let (shared, fresh) = (arm.pose_in(qa, &mut frames[k % 2]), arm.pose(qa));
+            assert_eq!(shared.frames.as_ref(), fresh.frames.as_ref());
+            assert_eq!(shared.chord_offset(2, 0), pose_chord(&fresh, 2, 0));
+        }
+    }
+
+    /// `c_j` computed directly.
+    fn pose_chord(p: &Pose<'_>, i: usize, j: usize) -> Vector2<f64> {
+        p.to_frame(i, &(p.origin(i) - p.origin(j)))
     }
 }

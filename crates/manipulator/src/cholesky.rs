@@ -60,15 +60,29 @@ impl Cholesky {
 
     /// `b ← M⁻¹ b` with the last factor (NaN if it failed).
     pub(crate) fn solve_in_place(&self, b: &mut [f64]) {
+        self.solve_from(0, b);
+    }
+
+    /// Column k of M⁻¹ into `b` (length n).
+    pub(crate) fn inverse_column(&self, k: usize, b: &mut [f64]) {
+        b.fill(0.0);
+        b[k] = 1.0;
+        self.solve_from(k, b);
+    }
+
+    /// `b ← M⁻¹ b` for a `b` whose entries before `first` are +0: the forward substitution
+    /// starts at `first`. The same numbers as from 0: the skipped entries stay +0, and the
+    /// skipped products are zeros that change no sum (`0 − (±0) = +0` where all are zero).
+    fn solve_from(&self, first: usize, b: &mut [f64]) {
         let n = self.n;
         if !self.ok {
             b.fill(f64::NAN);
             return;
         }
         // Uᵀ y = b
-        for i in 0..n {
+        for i in first..n {
             let col = &self.u[i * n..(i + 1) * n];
-            b[i] = (b[i] - dot(&col[..i], &b[..i])) * self.inv_diag[i];
+            b[i] = (b[i] - dot(&col[first..i], &b[first..i])) * self.inv_diag[i];
         }
         // U x = y
         for k in (0..n).rev() {
@@ -101,6 +115,17 @@ mod tests {
         c.solve_in_place(&mut b);
         for (got, want) in b.iter().zip(x.iter()) {
             assert!((got - want).abs() < 1e-13);
+        }
+        // a column of M⁻¹ by the shortened forward substitution: the same bits
+        for k in 0..5 {
+            let (mut full, mut short) = (vec![0.0; 5], vec![f64::NAN; 5]);
+            full[k] = 1.0;
+            c.solve_in_place(&mut full);
+            c.inverse_column(k, &mut short);
+            assert!(full
+                .iter()
+                .zip(&short)
+                .all(|(a, b)| a.to_bits() == b.to_bits()));
         }
         let mut bad = m.clone();
         bad[(2, 2)] = -1.0;

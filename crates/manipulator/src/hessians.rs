@@ -53,8 +53,8 @@ impl ArmKinematics<'_> {
             b.shape() == (n, n) && h.shape() == (n, n),
             "B and H must be n×n"
         );
-        b.fill(0.0);
-        h.fill(0.0);
+        b.as_mut_slice().fill(0.0);
+        h.as_mut_slice().fill(0.0);
         for i in 0..arm.n_links() {
             let g = arm.shape_integrals(i);
             let o = arm.modal_offset(i);
@@ -187,7 +187,7 @@ impl Pose<'_> {
         let n_links = self.arm().n_links();
         jd.fill(Vector2::zeros());
         for (j, c) in jd.iter_mut().enumerate().take(n_links) {
-            *c = self.pin_pair_joint_column(a, b, j);
+            *c = self.pin_pair_joint_column(a, b, (&ra, &rb), j);
         }
         self.pin_pair_mode_columns(a, b, |k, col| jd[k] += col);
         for (k, jk) in jd.iter().enumerate() {

@@ -37,8 +37,11 @@ impl ArmKinematics<'_> {
     /// If `m` is not n×n.
     pub fn mass_matrix_into(&self, m: &mut DMatrix<f64>) {
         let arm = self.arm();
-        assert_eq!(m.shape(), (arm.n(), arm.n()), "M must be n×n");
-        m.fill(0.0);
+        let n = arm.n();
+        assert_eq!(m.shape(), (n, n), "M must be n×n");
+        // column-major: M[(r, c)] at c n + r
+        let ms = m.as_mut_slice();
+        ms.fill(0.0);
         for i in 0..arm.n_links() {
             let g = arm.shape_integrals(i);
             let o = arm.modal_offset(i);
@@ -51,20 +54,22 @@ impl ArmKinematics<'_> {
                 for l in 0..=j {
                     let cl = self.pose.chord_offset(i, l);
                     let v = mass * cj.dot(&cl) + (cj.x + cl.x) * s1 + (cj.y + cl.y) * d.w + common;
-                    m[(j, l)] += v;
+                    ms[l * n + j] += v;
                     if l != j {
-                        m[(l, j)] += v;
+                        ms[j * n + l] += v;
                     }
                 }
-                for k in 0..qb.len() {
-                    let v = cj.x * g.mode_mass(k) + g.mode_moment(k) + g.rotary_mode(k);
-                    m[(j, o + k)] += v;
-                    m[(o + k, j)] += v;
+                for (k, c) in g.joint_mode_constants().iter().enumerate() {
+                    let v = cj.x * c[0] + c[1] + c[2];
+                    ms[(o + k) * n + j] += v;
+                    ms[j * n + o + k] += v;
                 }
             }
-            for k in 0..qb.len() {
-                for l in 0..qb.len() {
-                    m[(o + k, o + l)] += g.mode_product(k, l) + g.rotary_product(k, l);
+            // the modes' own block, constant: link i alone writes it (0 + (P + ∫ρI θθᵀ))
+            let mm = qb.len();
+            if mm > 0 {
+                for (l, col) in g.modal_mass().chunks_exact(mm).enumerate() {
+                    ms[(o + l) * n + o..(o + l) * n + o + mm].copy_from_slice(col);
                 }
             }
         }

@@ -145,6 +145,9 @@ impl ArmScene {
     /// member from its local name (for the signals members read from each other).
     pub fn composite(&self, instance: &str) -> Result<Composite, ParamError> {
         let member = |l: &str| member_name(instance, l);
+        // shared by the elements of one model, which runs on one thread: the arm keeps the
+        // frames at the last configuration in a RefCell (PlanarArm::pose_in), so it is not Sync
+        #[allow(clippy::arc_with_non_send_sync)]
         let arm = Arc::new(self.arm()?);
         let n = arm.n();
         let q0 = padded("q0", &self.q0, n)?;

@@ -52,6 +52,18 @@ pub struct ShapeIntegrals {
     bending: DMatrix<f64>,
     /// With geometric stiffening: the integrals of the shortening.
     shortening: Option<ShorteningIntegrals>,
+    /// Entries of G_A and G_I read per evaluation, laid out for it (see [`Self::finish`]).
+    fast: FastEntries,
+}
+
+/// The invariants the right-hand side reads on every evaluation, copied out of G_A and G_I
+/// once so that the loops run over contiguous memory (the same numbers, bit for bit).
+#[derive(Clone, Debug, Default, PartialEq)]
+struct FastEntries {
+    /// `[a_k, b_k, ∫ρI θ_k]` per mode k.
+    joint_mode: Vec<[f64; 3]>,
+    /// The modes' block of M, `0 + (P_kl + ∫ρI θ_k θ_l)`, column-major m × m.
+    modal_mass: Vec<f64>,
 }
 
 /// The ρA-weighted moments of a link's deflection at (q, u) that the dynamics need:
@@ -95,6 +107,7 @@ impl ShapeIntegrals {
             rotation: DMatrix::zeros(m + 1, m + 1),
             bending: DMatrix::zeros(m, m),
             shortening: None,
+            fast: FastEntries::default(),
         };
         let sines: Option<Vec<f64>> = if link.is_uniform() {
             link.modes().iter().map(|p| p.sine_wavenumber()).collect()
@@ -117,7 +130,33 @@ impl ShapeIntegrals {
         if link.geometric_stiffening() {
             s.shortening = Some(ShorteningIntegrals::of(link, points)?);
         }
+        s.finish();
         Ok(s)
+    }
+
+    /// Copy the entries of [`FastEntries`] out of the finished G_A and G_I.
+    fn finish(&mut self) {
+        let m = self.n_modes();
+        self.fast = FastEntries {
+            joint_mode: (0..m)
+                .map(|k| [self.mode_mass(k), self.mode_moment(k), self.rotary_mode(k)])
+                .collect(),
+            modal_mass: (0..m * m)
+                .map(|lk| {
+                    let (l, k) = (lk / m, lk % m);
+                    0.0 + (self.mode_product(k, l) + self.rotary_product(k, l))
+                })
+                .collect(),
+        };
+    }
+
+    /// `[a_k, b_k, ∫ρI θ_k]` per mode k: the constants of the joint–mode entries of M.
+    pub(crate) fn joint_mode_constants(&self) -> &[[f64; 3]] {
+        &self.fast.joint_mode
+    }
+    /// The modes' own block of M, `0 + (P_kl + ∫ρI θ_k θ_l)`, column-major m × m.
+    pub(crate) fn modal_mass(&self) -> &[f64] {
+        &self.fast.modal_mass
     }
 
     fn add_sines(&mut self, link: &Link, kappa: &[f64]) {

@@ -25,6 +25,8 @@ use crate::kinematics::ArmKinematics;
 pub struct ArmCompliance {
     arm: Arc<PlanarArm>,
     k: DMatrix<f64>,
+    /// K row by row (`K[(k, l)]` at `k n + l`), for the effort's `K q`.
+    k_rows: Vec<f64>,
     q_signal: String,
     ws: RefCell<Workspace>,
 }
@@ -76,8 +78,10 @@ impl ArmCompliance {
     #[must_use]
     pub fn new(arm: Arc<PlanarArm>, q_signal: &str) -> Self {
         let n = arm.n();
+        let k = arm.stiffness_matrix();
         Self {
-            k: arm.stiffness_matrix(),
+            k_rows: k.transpose().as_slice().to_vec(),
+            k,
             ws: RefCell::new(Workspace {
                 frames: arm.frames(),
                 gravity: AtLastQ::new(
@@ -147,10 +151,10 @@ impl Element for ArmCompliance {
         let (q, gravity) = ws.gravity(&self.arm, io.input(0));
         if stage == 0 {
             for (k, gk) in gravity.g.iter().enumerate() {
-                let kq: f64 = q
+                let kq: f64 = self.k_rows[k * q.len()..(k + 1) * q.len()]
                     .iter()
-                    .enumerate()
-                    .map(|(l, ql)| self.k[(k, l)] * ql)
+                    .zip(q)
+                    .map(|(kl, ql)| kl * ql)
                     .sum();
                 io.set_e(0, k, kq - gk);
             }

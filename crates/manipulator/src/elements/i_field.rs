@@ -232,18 +232,21 @@ impl Partials {
         let kin = ArmKinematics::new(arm.pose_in(&x[n..], frames));
         kin.kinetic_partials_into(u, b, dpdot_dq);
         for (k, col) in minv.as_mut_slice().chunks_mut(n).enumerate() {
-            col.fill(0.0);
-            col[k] = 1.0;
-            factor.solve_in_place(col);
+            factor.inverse_column(k, col);
         }
         minv_b.copy_from(b);
         for col in minv_b.as_mut_slice().chunks_mut(n) {
             factor.solve_in_place(col);
         }
-        for c in 0..n {
-            for r in 0..n {
-                let bt_x: f64 = (0..n).map(|a| b[(a, r)] * minv_b[(a, c)]).sum();
-                dpdot_dq[(r, c)] -= bt_x;
+        // (BᵀM⁻¹B)_rc: columns r of B and c of M⁻¹B, contiguous (column-major)
+        let (bs, xs) = (b.as_slice(), minv_b.as_slice());
+        for (xc, dc) in xs
+            .chunks_exact(n)
+            .zip(dpdot_dq.as_mut_slice().chunks_exact_mut(n))
+        {
+            for (br, d) in bs.chunks_exact(n).zip(dc) {
+                let bt_x: f64 = br.iter().zip(xc).map(|(p, x)| p * x).sum();
+                *d -= bt_x;
             }
         }
     }

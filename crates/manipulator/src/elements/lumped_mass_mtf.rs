@@ -93,7 +93,7 @@ fn jt_at<'a>(
 ) -> (&'a [f64], &'a DMatrix<f64>) {
     jt.get_or_update(q, |q, jt| {
         let pose = arm.pose_in(q, frames);
-        jt.fill(0.0);
+        jt.as_mut_slice().fill(0.0);
         for (k, s) in stations.iter().enumerate() {
             pose.point_jacobian(s, |i, col| {
                 jt[(i, 2 * k)] = col.x;
