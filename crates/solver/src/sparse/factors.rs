@@ -145,7 +145,7 @@ impl<T: Scalar> Factors<T> {
             for s in ptr[q]..ptr[q + 1] {
                 let mut v = T::real(-jac[s]);
                 if s == diag[q] {
-                    v = v + shift;
+                    v += shift;
                 }
                 x[self.a_row[s]] += v;
             }

@@ -122,7 +122,7 @@ impl<T: Scalar> SparseLu<T> {
             *v = T::real(-j);
         }
         for &d in pattern.diag() {
-            self.values[d] = self.values[d] + shift;
+            self.values[d] += shift;
         }
         let a = SparseColMatRef::new(pattern.symbolic(), &self.values);
         let n = pattern.n();
@@ -147,7 +147,7 @@ impl<T: Scalar> SparseLu<T> {
         self.counts
     }
 
-    /// Stored entries of L and U.
+    /// Stored entries of L and U (both diagonals included).
     pub(crate) fn factor_nnz(&self) -> usize {
         self.factors.nnz()
     }
