@@ -9,8 +9,8 @@
 //! - [`radau`]: Radau IIA of order 5 ([`Radau5`]): one step at a time towards stop times,
 //!   dense output, restarts, its step-size control and tableau.
 //! - `lu` (private): the dense LU kernels of Radau's real and complex iteration matrices.
-//! - `sparse` (private but for [`SparsePattern`]): the sparse LU of the same matrices (faer's,
-//!   symbolic analysis once per pattern).
+//! - `sparse` (private but for [`SparsePattern`]): the sparse LU of the same matrices
+//!   (KLU's scheme: refactorised on a stored pivot order, faer's pivoted LU where it fails).
 
 mod lu;
 pub mod problem;

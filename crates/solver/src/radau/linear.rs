@@ -1,6 +1,7 @@
 //! The linear algebra of a step: the Jacobian J and the two iteration matrices
-//! (γ/h)I − J and ((α + iβ)/h)I − J, dense (our LU kernels, `crate::lu`) or sparse (faer's
-//! sparse LU over the problem's pattern, `crate::sparse`), chosen once per integrator.
+//! (γ/h)I − J and ((α + iβ)/h)I − J, dense (our LU kernels, `crate::lu`) or sparse
+//! (`crate::sparse`: refactorised on a stored pivot order, faer's pivoted sparse LU where
+//! that order fails), chosen once per integrator.
 
 use nalgebra::{Complex, DMatrix};
 
@@ -79,9 +80,13 @@ impl std::fmt::Debug for Linear {
             Self::Dense { jac, .. } => write!(f, "Dense({}×{})", jac.nrows(), jac.ncols()),
             Self::Sparse(s) => write!(
                 f,
-                "Sparse(n = {}, nnz = {})",
+                "Sparse(n = {}, nnz = {}, L+U nnz = {}/{}, real {:?}, complex {:?})",
                 s.pattern.n(),
-                s.pattern.nnz()
+                s.pattern.nnz(),
+                s.real.factor_nnz(),
+                s.complex.factor_nnz(),
+                s.real.counts(),
+                s.complex.counts()
             ),
         }
     }
