@@ -269,10 +269,13 @@ impl Simulation {
             return x[i];
         }
         let mut reads = self.reads.borrow_mut();
-        let k = reads.iter().position(|(p, _)| *p == probe).unwrap_or_else(|| {
-            reads.push((probe, self.eqs.subset(&[probe])));
-            reads.len() - 1
-        });
+        let k = reads
+            .iter()
+            .position(|(p, _)| *p == probe)
+            .unwrap_or_else(|| {
+                reads.push((probe, self.eqs.subset(&[probe])));
+                reads.len() - 1
+            });
         self.eqs.evaluate_only(&reads[k].1, t, x);
         self.eqs.read(probe, t, x)
     }
