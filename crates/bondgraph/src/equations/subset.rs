@@ -63,12 +63,12 @@ impl StateEquations {
         }
         // Depth-first over the writers of what is wanted.
         let mut needed = vec![false; self.order.len()];
-        let mut stack: Vec<usize> = wanted.iter().filter_map(|v| writer(v)).collect();
+        let mut stack: Vec<usize> = wanted.iter().filter_map(&writer).collect();
         while let Some(k) = stack.pop() {
             if std::mem::replace(&mut needed[k], true) {
                 continue;
             }
-            stack.extend(reads[k].iter().filter_map(|v| writer(v)));
+            stack.extend(reads[k].iter().filter_map(&writer));
         }
         derivatives.sort_unstable();
         Subset {
