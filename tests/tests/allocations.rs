@@ -71,6 +71,35 @@ fn check(name: &str) {
     let (rhs, jac) = allocations(&model.equations);
     assert_eq!(rhs, (0, 0), "{name}: (allocations, bytes) in 100 rhs calls");
     assert_eq!(jac, (0, 0), "{name}: (allocations, bytes) in 10 Jacobians");
+    assert_eq!(
+        subset_allocations(&model),
+        (0, 0),
+        "{name}: (allocations, bytes) in 100 evaluations of the outputs' stages"
+    );
+}
+
+/// Allocations (count, bytes) of 100 evaluations of the stages the outputs need
+/// (`evaluate_only`, what a run does for every row and step), and their reads.
+fn subset_allocations(model: &bg_model::Model) -> (usize, usize) {
+    let eqs = &model.equations;
+    let probes: Vec<bondgraph::Probe> = model.outputs.iter().map(|o| o.probe).collect();
+    let subset = eqs.subset(&probes);
+    let x0 = model.x0.clone();
+    eqs.evaluate_only(&subset, 0.0, &x0);
+    let mut best = (usize::MAX, 0);
+    for _ in 0..3 {
+        let mut sum = 0.0;
+        let region = Region::new(GLOBAL);
+        for k in 0..100 {
+            let t = 1e-3 * f64::from(k);
+            eqs.evaluate_only(&subset, t, &x0);
+            sum += probes.iter().map(|&p| eqs.read(p, t, &x0)).sum::<f64>();
+        }
+        let c = region.change();
+        std::hint::black_box(sum);
+        best = best.min((c.allocations + c.reallocations, c.bytes_allocated));
+    }
+    best
 }
 
 /// The allocator counts every thread, and the test harness allocates on its own thread when

@@ -130,6 +130,10 @@ impl RowSink for Progress<'_> {
             self.inner.step(values);
         }
     }
+    /// The bar reads `t` alone.
+    fn step_reads(&self, column: usize) -> bool {
+        self.inner.wants_steps() && self.inner.step_reads(column)
+    }
 }
 
 impl Drop for Progress<'_> {

@@ -9,6 +9,7 @@
 //! - `plan`: building the plan (storage, stages, their order, algebraic loops).
 //! - `names`: signal names an element reads, probe names a run outputs.
 //! - `evaluate`: `rhs`, evaluation at a point, powers, energies, the first non-finite value.
+//! - `subset`: the stages a set of probes needs, and evaluating only those.
 //! - `inputs`: external inputs set from outside.
 //! - `jacobian`: the exact Jacobian (dense or sparse), compiled from the plan.
 //! - `lengths`: port lengths that must agree.
@@ -26,7 +27,9 @@ mod jacobian;
 mod lengths;
 mod names;
 mod plan;
+mod subset;
 pub use lengths::{LengthMismatch, LENGTH_TOLERANCE_ABS, LENGTH_TOLERANCE_REL};
+pub use subset::Subset;
 
 /// A named state of the assembled system.
 #[derive(Clone, Debug)]

@@ -109,7 +109,7 @@ pub use element::{
 };
 pub use elements::*;
 pub use energy::{ElementEnergy, EnergyAudit, EnergyReport, EnergyRole};
-pub use equations::{LengthMismatch, Probe, StateEquations, StateInfo};
+pub use equations::{LengthMismatch, Probe, StateEquations, StateInfo, Subset};
 pub use equilibrium::{
     solve_steady, steady_size_error, Condition, Equilibrium, EquilibriumError, Settle,
     SteadyRequest, MAX_STEADY_STATES, MAX_STEADY_UNKNOWNS, OWN_SCALE_FRACTION,

@@ -591,6 +591,59 @@ fn rows_stream_to_a_sink_with_every_accepted_step() {
     assert!(sink.steps.windows(2).all(|w| w[0] < w[1]));
 }
 
+/// A sink that keeps every step's values and reads the columns `reads` says (all: `None`).
+struct Steps {
+    reads: Option<usize>,
+    steps: Vec<Vec<f64>>,
+}
+
+impl RowSink for Steps {
+    fn row(&mut self, _row: &[f64]) -> Result<(), String> {
+        Ok(())
+    }
+    fn wants_steps(&self) -> bool {
+        true
+    }
+    fn step(&mut self, values: &[f64]) {
+        self.steps.push(values.to_vec());
+    }
+    fn step_reads(&self, column: usize) -> bool {
+        self.reads.is_none_or(|c| c == column)
+    }
+}
+
+/// At every step only the columns the sink reads are evaluated (only their stages run):
+/// they hold what a whole evaluation gives, bit for bit; the others are NaN.
+#[test]
+fn a_step_evaluates_only_the_columns_the_sink_reads() {
+    let s = settings(Method::Bdf, 1.0, 0.1, 1e-8, 1e-12);
+    let mut eqs = mass_spring_damper(1.0, 100.0, 0.4, 0.01);
+    let x0 = eqs.initial_state();
+    let outs = [
+        output(&eqs, "mass.f"),
+        output(&eqs, "spring.e"),
+        output(&eqs, "damper.e"),
+    ];
+    let mut all = Steps {
+        reads: None,
+        steps: Vec::new(),
+    };
+    let mut one = Steps {
+        reads: Some(1),
+        steps: Vec::new(),
+    };
+    simulate_into(&mut eqs, &x0, &s, &outs, vec![], &mut all);
+    simulate_into(&mut eqs, &x0, &s, &outs, vec![], &mut one);
+    assert!(all.steps.len() > 10);
+    assert_eq!(all.steps.len(), one.steps.len());
+    for (a, o) in all.steps.iter().zip(&one.steps) {
+        assert!(a.iter().all(|v| v.is_finite()), "{a:?}");
+        assert_eq!(o[0].to_bits(), a[0].to_bits());
+        assert_eq!(o[2].to_bits(), a[2].to_bits(), "spring.e");
+        assert!(o[1].is_nan() && o[3].is_nan(), "{o:?}");
+    }
+}
+
 /// A refused row (a full disk) stops the run at once, keeping the rows before it.
 #[test]
 fn a_refused_row_stops_the_run() {

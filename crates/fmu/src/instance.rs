@@ -13,7 +13,7 @@
 use std::path::{Path, PathBuf};
 
 use bg_model::{Model, ModelError, Registry, Stepping};
-use bondgraph::Probe;
+use bondgraph::{Probe, Subset};
 
 use crate::description::{Description, Role};
 
@@ -99,6 +99,8 @@ pub struct Instance {
     run: Option<Stepping>,
     /// The probes of the output variables (by value reference; `None` for the others).
     probes: Vec<Option<Probe>>,
+    /// The stages the output variables need, evaluated alone.
+    reads: Subset,
     /// The outputs at the current time and state, evaluated once for all of them (by value
     /// reference); empty when stale (after a step, an input set, a state set).
     outputs: Vec<f64>,
@@ -205,6 +207,7 @@ impl Instance {
             model: Some(model),
             run: None,
             probes: Vec::new(),
+            reads: Subset::default(),
             outputs: Vec::new(),
             values,
             inputs_set: vec![false; n_inputs],
@@ -301,6 +304,8 @@ impl Instance {
                 probes[v.vr as usize] = Some(run.probe(name)?);
             }
         }
+        let read: Vec<Probe> = probes.iter().flatten().copied().collect();
+        self.reads = run.simulation().equations().subset(&read);
         self.probes = probes;
         self.outputs.clear();
         self.run = Some(run);
@@ -361,13 +366,13 @@ impl Instance {
         }
     }
 
-    /// Every output at the current time and state: one evaluation of the equations for
-    /// all of them (reading them one by one would evaluate the equations each time).
+    /// Every output at the current time and state: one evaluation, of the stages they need,
+    /// for all of them (reading them one by one would evaluate those stages each time).
     fn evaluate_outputs(&mut self) {
         let Some(run) = &self.run else { return };
         let sim = run.simulation();
         let (t, x, eqs) = (sim.t(), sim.state(), sim.equations());
-        eqs.evaluate(t, x);
+        eqs.evaluate_only(&self.reads, t, x);
         self.outputs = self
             .probes
             .iter()

@@ -147,7 +147,7 @@ impl StateEquations {
         Ok(())
     }
 
-    fn var_of(&self, id: ElementId, slot: Slot) -> Option<Var> {
+    pub(super) fn var_of(&self, id: ElementId, slot: Slot) -> Option<Var> {
         let bond = |p: usize| self.graph.ports_of(id).get(p).copied().flatten();
         match slot {
             Slot::Effort(p) => bond(p).map(Var::Effort),
@@ -170,7 +170,7 @@ impl StateEquations {
         }
     }
 
-    fn signal_owner(&self, offset: usize) -> Option<Var> {
+    pub(super) fn signal_owner(&self, offset: usize) -> Option<Var> {
         self.layouts.iter().enumerate().find_map(|(id, l)| {
             l.outputs
                 .iter()

@@ -54,6 +54,6 @@ pub use settings::{
 pub use stepping::Simulation;
 
 use outcome::start_outcome;
-use record::{same_time, Grid, Progress, Recorder};
+use record::{same_time, Grid, Progress, Reads, Recorder};
 use run::{culprit, SegmentError};
 use watch::{bounds, Bound};

@@ -5,7 +5,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use super::watch::{watch, Watcher};
 use super::Settings;
-use crate::equations::{Probe, StateEquations};
+use crate::equations::{Probe, StateEquations, Subset};
 use crate::error::SimulationError;
 
 /// A named output column.
@@ -30,6 +30,11 @@ pub trait RowSink {
     /// The outputs (`t` first) at an accepted solver step, between output rows: what a check
     /// that must hold at every step reads. Called only if [`RowSink::wants_steps`].
     fn step(&mut self, _values: &[f64]) {}
+    /// Whether [`RowSink::step`] reads output column `column` (0: the first output, after
+    /// `t`). The recorder evaluates only what the columns read need; the others are NaN.
+    fn step_reads(&self, _column: usize) -> bool {
+        true
+    }
 }
 
 impl RowSink for Vec<Vec<f64>> {
@@ -74,6 +79,38 @@ impl Grid {
     }
 }
 
+/// What the recorder evaluates, found once per run: the stages the output columns need, and
+/// those the columns the sink reads at every accepted step need.
+#[derive(Default)]
+pub(super) struct Reads {
+    rows: Subset,
+    steps: Subset,
+    /// Per output column: read at steps.
+    step_columns: Vec<bool>,
+}
+
+impl Reads {
+    pub(super) fn new(eqs: &StateEquations, outputs: &[Output], sink: &dyn RowSink) -> Self {
+        let probes: Vec<Probe> = outputs.iter().map(|o| o.probe).collect();
+        let step_columns: Vec<bool> = if sink.wants_steps() {
+            (0..outputs.len()).map(|k| sink.step_reads(k)).collect()
+        } else {
+            vec![false; outputs.len()]
+        };
+        let step_probes: Vec<Probe> = probes
+            .iter()
+            .zip(&step_columns)
+            .filter(|(_, &r)| r)
+            .map(|(&p, _)| p)
+            .collect();
+        Self {
+            rows: eqs.subset(&probes),
+            steps: eqs.subset(&step_probes),
+            step_columns,
+        }
+    }
+}
+
 /// What the recorder carries from one segment to the next.
 pub(super) struct Progress {
     pub(super) watchers: Vec<Watcher>,
@@ -96,20 +133,29 @@ pub(super) struct Recorder<'e> {
     /// output row at an event time is), not before.
     pub(super) event_at: Option<f64>,
     pub(super) buf: Vec<f64>,
+    /// What a row and a step evaluate.
+    pub(super) reads: &'e Reads,
     pub(super) p: Progress,
     /// The energy audit fed after every accepted step ([`super::simulate_audited`]), if any.
     pub(super) audit: Option<&'e mut crate::energy::EnergyAudit>,
 }
 
 impl Recorder<'_> {
-    /// `t` and the outputs at (t, x) into `buf`.
-    pub(super) fn values(&mut self, t: f64, x: &[f64]) {
-        self.eqs.evaluate(t, x);
+    /// `t` and the outputs at (t, x) into `buf`: every output for a row, those the sink
+    /// reads for a step (the others NaN). Only the stages they need are evaluated.
+    fn values(&mut self, t: f64, x: &[f64], step: bool) {
+        let (eqs, reads) = (self.eqs, self.reads);
+        eqs.evaluate_only(if step { &reads.steps } else { &reads.rows }, t, x);
         self.buf.clear();
         self.buf.push(t);
-        let eqs = self.eqs;
         self.buf
-            .extend(self.outputs.iter().map(|o| eqs.read(o.probe, t, x)));
+            .extend(self.outputs.iter().enumerate().map(|(k, o)| {
+                if step && !reads.step_columns[k] {
+                    f64::NAN
+                } else {
+                    eqs.read(o.probe, t, x)
+                }
+            }));
     }
     /// The row of the pending grid time `t`; after a refused row, rows are skipped.
     pub(super) fn record(&mut self, t: f64, x: &[f64]) {
@@ -117,7 +163,7 @@ impl Recorder<'_> {
         if self.p.stop.is_some() {
             return;
         }
-        self.values(t, x);
+        self.values(t, x, false);
         match self.sink.row(&self.buf) {
             Ok(()) => self.p.rows += 1,
             Err(message) => self.p.stop = Some(SimulationError::Output { t, message }),
@@ -137,7 +183,7 @@ impl Recorder<'_> {
     }
     /// Hand the outputs at (t, x) to the sink as a step.
     pub(super) fn step_values(&mut self, t: f64, x: &[f64]) {
-        self.values(t, x);
+        self.values(t, x, true);
         self.sink.step(&self.buf);
     }
     pub(super) fn should_stop(&mut self, t: f64) -> Result<(), SimulationError> {

@@ -4,7 +4,7 @@
 use std::cell::RefCell;
 use std::time::Instant;
 
-use super::record::{same_time, Grid, Progress, Recorder};
+use super::record::{same_time, Grid, Progress, Reads, Recorder};
 use super::segment::run_segment;
 use super::watch::{bounds, reports, watch, watchers};
 use super::{check_in_memory, start_outcome, Event, Outcome, Output, RowSink, Settings};
@@ -123,6 +123,7 @@ pub fn simulate_audited(
         stop: None,
     };
     let mut buf = Vec::with_capacity(outputs.len() + 1);
+    let reads = Reads::new(eqs, outputs, &*sink);
     watch(&mut progress.watchers, t0, x0);
     loop {
         // Apply every event due now.
@@ -161,6 +162,7 @@ pub fn simulate_audited(
             wants_steps,
             event_at: (t_event < t_end && same_time(t_event, t_stop)).then_some(t_stop),
             buf: std::mem::take(&mut buf),
+            reads: &reads,
             p: progress,
             audit: audit.as_deref_mut(),
         };

@@ -27,8 +27,10 @@ use std::cell::RefCell;
 
 use super::radau::{RadauEquations, RadauStepper, RADAU_JACOBIAN_THETA};
 use super::stepper::drive;
-use super::{bounds, same_time, Bound, Event, Grid, Progress, Recorder, Settings, Statistics};
-use crate::equations::{Probe, StateEquations};
+use super::{
+    bounds, same_time, Bound, Event, Grid, Progress, Reads, Recorder, Settings, Statistics,
+};
+use crate::equations::{Probe, StateEquations, Subset};
 use crate::error::SimulationError;
 use crate::radau::{Radau5, RadauOptions};
 
@@ -51,6 +53,8 @@ pub struct Simulation {
     wall: std::time::Duration,
     /// Why the simulation cannot go on, once it failed.
     failed: Option<SimulationError>,
+    /// The stages each probe read so far needs ([`Simulation::read`]), found at its first read.
+    reads: RefCell<Vec<(Probe, Subset)>>,
 }
 
 impl Simulation {
@@ -165,6 +169,7 @@ impl Simulation {
             events_applied: applied,
             wall: std::time::Duration::ZERO,
             failed: None,
+            reads: RefCell::new(Vec::new()),
         })
     }
 
@@ -255,14 +260,23 @@ impl Simulation {
         Ok(())
     }
 
-    /// The value of `probe` at the current time and state.
+    /// The value of `probe` at the current time and state: only the stages it needs are
+    /// evaluated (found at its first read, then kept: later reads allocate nothing).
     #[must_use]
     pub fn read(&self, probe: Probe) -> f64 {
         let (t, x) = (self.t(), self.state());
         if let Probe::State(i) = probe {
             return x[i];
         }
-        self.eqs.evaluate(t, x);
+        let mut reads = self.reads.borrow_mut();
+        let k = reads
+            .iter()
+            .position(|(p, _)| *p == probe)
+            .unwrap_or_else(|| {
+                reads.push((probe, self.eqs.subset(&[probe])));
+                reads.len() - 1
+            });
+        self.eqs.evaluate_only(&reads[k].1, t, x);
         self.eqs.read(probe, t, x)
     }
 
@@ -387,6 +401,7 @@ impl Simulation {
             wants_steps: false,
             event_at: None,
             buf: Vec::new(),
+            reads: &Reads::default(),
             p: Progress {
                 watchers: Vec::new(),
                 next: 1,

@@ -92,6 +92,8 @@ pub(super) struct CheckSink<'a> {
     compiled: Vec<(crate::expr::Compiled, crate::expr::Compiled)>,
     worst: Vec<Worst>,
     points: usize,
+    /// Per output column (after `t`): read by a check.
+    reads: Vec<bool>,
 }
 
 impl<'a> CheckSink<'a> {
@@ -110,7 +112,13 @@ impl<'a> CheckSink<'a> {
             }
         };
         let mut compiled = Vec::new();
+        let mut reads = vec![false; model.outputs.len()];
         for c in &model.checks {
+            for n in c.value_expr.names().iter().chain(&c.expected_expr.names()) {
+                if let Some(k) = model.outputs.iter().position(|o| &o.name == n) {
+                    reads[k] = true;
+                }
+            }
             let compile = |e: &Expr| {
                 e.compile(&constant, &columns).map_err(|m| {
                     model.source.err(
@@ -127,6 +135,7 @@ impl<'a> CheckSink<'a> {
             worst: vec![Worst::NONE; compiled.len()],
             compiled,
             points: 0,
+            reads,
         })
     }
     fn evaluate(&mut self, values: &[f64]) {
@@ -158,6 +167,10 @@ impl bondgraph::RowSink for CheckSink<'_> {
         if self.inner.wants_steps() {
             self.inner.step(values);
         }
+    }
+    fn step_reads(&self, column: usize) -> bool {
+        self.reads.get(column).copied().unwrap_or(false)
+            || (self.inner.wants_steps() && self.inner.step_reads(column))
     }
 }
 
