@@ -377,10 +377,53 @@ fn profile(what: &str, path: &str) {
     println!("{what}: {:.2} µs per factorisation", 3e6 / f64::from(calls));
 }
 
+/// `LU_COUNT=real|complex|solve`: a fixed amount of work on the first file's Jacobians
+/// (each factorised at h = 1e-4, 1e-3, 1e-2, `LU_REPS` times, default 10), for instruction
+/// counts under `valgrind --tool=callgrind` (per call: the function's inclusive count over
+/// the number of calls printed).
+fn count(what: &str, path: &str) {
+    let (n, jacs) = read_jacobians(path);
+    let reps: usize = std::env::var("LU_REPS").map_or(10, |v| v.parse().unwrap());
+    let (mut r, mut c) = (new::RealLu::new(n), new::ComplexLu::new(n));
+    let (b, bc) = rhs(n);
+    let (bre, bim): (Vec<f64>, Vec<f64>) = bc.iter().map(|v| (v.re, v.im)).unzip();
+    let (mut y, mut yr, mut yi) = (b.clone(), bre.clone(), bim.clone());
+    let mut calls = 0;
+    let mut check = 0.0;
+    for _ in 0..reps {
+        for jac in &jacs {
+            for h in [1e-4, 1e-3, 1e-2] {
+                if what != "complex" {
+                    r.set_shifted(GAMMA / h, black_box(jac));
+                    r.factor().unwrap();
+                }
+                if what != "real" {
+                    c.set_shifted(Complex::new(ALPHA / h, BETA / h), black_box(jac));
+                    c.factor().unwrap();
+                }
+                if what == "solve" {
+                    y.copy_from_slice(&b);
+                    r.solve(black_box(&mut y));
+                    yr.copy_from_slice(&bre);
+                    yi.copy_from_slice(&bim);
+                    c.solve(black_box(&mut yr), black_box(&mut yi));
+                    check += y[0] + yr[0] + yi[0];
+                }
+                calls += 1;
+            }
+        }
+    }
+    println!("{what}: {calls} calls (check {check:e})");
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if let (Ok(what), Some(path)) = (std::env::var("LU_PROFILE"), args.first()) {
         profile(&what, path);
+        return;
+    }
+    if let (Ok(what), Some(path)) = (std::env::var("LU_COUNT"), args.first()) {
+        count(&what, path);
         return;
     }
     for path in &args {

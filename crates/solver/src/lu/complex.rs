@@ -4,9 +4,7 @@
 use nalgebra::Complex;
 use pulp::{Arch, Simd, WithSimd};
 
-use super::{
-    caxpy, caxpy2, caxpy_twice, nonzero_rows, pivot, two_columns, widen, Pattern, Singular,
-};
+use super::{caxpy, caxpy2, caxpy_twice, nonzero_rows, pivot, widen, Pattern, Singular};
 
 /// A complex n×n matrix on separate real and imaginary planes and, after
 /// [`ComplexLu::factor`], its factors P·A = L·U in place.
@@ -53,15 +51,15 @@ impl ComplexLu {
         impl WithSimd for Op<'_> {
             type Output = Result<(), Singular>;
             #[inline(always)]
-            fn with_simd<S: Simd>(self, _: S) -> Self::Output {
-                self.0.factor_kernel()
+            fn with_simd<S: Simd>(self, simd: S) -> Self::Output {
+                self.0.factor_kernel(simd)
             }
         }
         self.arch.dispatch(Op(self))
     }
 
     #[inline(always)]
-    fn factor_kernel(&mut self) -> Result<(), Singular> {
+    fn factor_kernel<S: Simd>(&mut self, simd: S) -> Result<(), Singular> {
         let n = self.n;
         let pat = &mut self.pat;
         for k in 0..n {
@@ -73,16 +71,8 @@ impl ComplexLu {
             let size = |i: usize| kr[k + i].abs() + ki[k + i].abs();
             let p = k + pivot(n - k, size).ok_or(Singular)?;
             pat.piv[k] = p;
-            if p != k {
-                kr.swap(k, p);
-                ki.swap(k, p);
-                for colj in right_re.chunks_exact_mut(n) {
-                    colj.swap(k, p);
-                }
-                for colj in right_im.chunks_exact_mut(n) {
-                    colj.swap(k, p);
-                }
-            }
+            kr.swap(k, p);
+            ki.swap(k, p);
             // 1/pivot and the scaling, with the operations of `num_complex`.
             let (cr, ci) = (kr[k], ki[k]);
             let ns = cr * cr + ci * ci;
@@ -96,32 +86,43 @@ impl ComplexLu {
             let (lo, hi) = widen(lo, hi, k + 1, n);
             pat.lo[k] = lo;
             pat.hi[k] = hi;
+            let trailing = right_re
+                .chunks_exact_mut(n)
+                .zip(right_im.chunks_exact_mut(n));
             if lo == hi {
+                if p != k {
+                    for (cr, ci) in trailing {
+                        cr.swap(k, p);
+                        ci.swap(k, p);
+                    }
+                }
                 continue;
             }
-            let mut count = 0;
-            let trailing = right_re.chunks_exact(n).zip(right_im.chunks_exact(n));
-            for (j, (cr, ci)) in trailing.enumerate() {
-                pat.cols[count] = j;
-                count += usize::from(cr[k].abs() + ci[k].abs() > 0.0);
-            }
+            // Interchange and update in one pass, as in the real kernel.
             let l = (&kr[lo..hi], &ki[lo..hi]);
-            let mut pairs = pat.cols[..count].chunks_exact(2);
-            for pair in &mut pairs {
-                let (xr, yr) = two_columns(right_re, n, pair[0], pair[1]);
-                let (xi, yi) = two_columns(right_im, n, pair[0], pair[1]);
-                let (a, b) = ((xr[k], xi[k]), (yr[k], yi[k]));
-                let (x, y) = (
-                    (&mut xr[lo..hi], &mut xi[lo..hi]),
-                    (&mut yr[lo..hi], &mut yi[lo..hi]),
-                );
-                caxpy2(x.0, x.1, y.0, y.1, l.0, l.1, a, b);
+            let mut pending: Option<(&mut [f64], &mut [f64])> = None;
+            for (cr, ci) in trailing {
+                if p != k {
+                    cr.swap(k, p);
+                    ci.swap(k, p);
+                }
+                if cr[k].abs() + ci[k].abs() > 0.0 {
+                    match pending.take() {
+                        None => pending = Some((cr, ci)),
+                        Some((xr, xi)) => {
+                            let (a, b) = ((xr[k], xi[k]), (cr[k], ci[k]));
+                            let (x, y) = (
+                                (&mut xr[lo..hi], &mut xi[lo..hi]),
+                                (&mut cr[lo..hi], &mut ci[lo..hi]),
+                            );
+                            caxpy2(simd, x.0, x.1, y.0, y.1, l.0, l.1, a, b);
+                        }
+                    }
+                }
             }
-            if let [j] = *pairs.remainder() {
-                let xr = &mut right_re[j * n..(j + 1) * n];
-                let xi = &mut right_im[j * n..(j + 1) * n];
+            if let Some((xr, xi)) = pending {
                 let a = (xr[k], xi[k]);
-                caxpy(&mut xr[lo..hi], &mut xi[lo..hi], l.0, l.1, a);
+                caxpy(simd, &mut xr[lo..hi], &mut xi[lo..hi], l.0, l.1, a);
             }
         }
         for k in 0..n {
@@ -139,15 +140,15 @@ impl ComplexLu {
         impl WithSimd for Op<'_> {
             type Output = ();
             #[inline(always)]
-            fn with_simd<S: Simd>(self, _: S) {
-                self.0.solve_kernel(self.1, self.2);
+            fn with_simd<S: Simd>(self, simd: S) {
+                self.0.solve_kernel(simd, self.1, self.2);
             }
         }
         self.arch.dispatch(Op(self, re, im));
     }
 
     #[inline(always)]
-    fn solve_kernel(&self, br: &mut [f64], bi: &mut [f64]) {
+    fn solve_kernel<S: Simd>(&self, simd: S, br: &mut [f64], bi: &mut [f64]) {
         let (n, re, im, pat) = (self.n, &self.re, &self.im, &self.pat);
         for k in 0..n {
             let p = pat.piv[k];
@@ -157,7 +158,14 @@ impl ComplexLu {
             if x.0 != 0.0 || x.1 != 0.0 {
                 let (lo, hi) = (pat.lo[k], pat.hi[k]);
                 let l = k * n + lo..k * n + hi;
-                caxpy(&mut br[lo..hi], &mut bi[lo..hi], &re[l.clone()], &im[l], x);
+                caxpy(
+                    simd,
+                    &mut br[lo..hi],
+                    &mut bi[lo..hi],
+                    &re[l.clone()],
+                    &im[l],
+                    x,
+                );
             }
         }
         // U x = y, two columns per pass as in the real solve.

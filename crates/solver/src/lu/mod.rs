@@ -11,12 +11,17 @@
 //! mechanical–hydraulic models:
 //! - **Sparsity, found numerically.** Column k of L is scanned for its first and last
 //!   non-zero row and the trailing update only touches those rows; only the trailing columns
-//!   with a non-zero in row k are updated (gathered without branches). No symbolic pattern
-//!   is needed, so a Jacobian whose zeros move costs nothing extra. On the knuckle-boom crane
-//!   (n = 38) this does about half the multiply-adds of a dense LU.
-//! - **Two trailing columns per pass**, sharing the loads of the L column; row ranges
-//!   widened to a multiple of four rows (over exact zeros) so the vector loops have no
-//!   scalar remainder.
+//!   with a non-zero in row k are updated. No symbolic pattern is needed, so a Jacobian
+//!   whose zeros move costs nothing extra. On the knuckle-boom crane (n = 38) this does
+//!   about half the multiply-adds of a dense LU.
+//! - **One pass over the trailing columns per step**: each column has rows k and p
+//!   interchanged, is tested, and is updated in the same visit, two columns at a time (the
+//!   first of a pair waits for the second), sharing the loads of the L column; row ranges
+//!   widened to a multiple of four rows (over exact zeros).
+//! - **Explicit four-wide vectors** in the updates of factorisations and forward solves
+//!   (pulp's `f64s`): LLVM's own vectorisation ran eight rows per iteration and left the
+//!   last four rows of most columns to a scalar loop (40 % of the real kernel's update
+//!   instructions on the crane).
 //! - **Complex numbers on separate real and imaginary planes**, so that the inner loops
 //!   vectorise (2.5× faster than `Complex<f64>` elements at n = 38).
 //! - **LINPACK-style interchanges**: row k is swapped with the pivot row in the trailing
@@ -31,10 +36,10 @@
 //! **Bit-identical results.** Every entry receives the same operations in the same order as
 //! in the textbook dense LU with partial pivoting and its forward and back substitution
 //! (the skipped ones are exact zeros, x − 0·a = x), so factors and solutions are the same to
-//! the last bit, up to the sign of zero entries; the tests check this. It matters: the step-size control amplifies any
-//! round-off change to the tolerance level (multiplying by stored reciprocals of the pivots
-//! instead of dividing made the solves 20 % faster but moved the crane's trajectory by
-//! 2.5e-5 of its scale, with 901 steps instead of 882).
+//! the last bit, up to the sign of zero entries; the tests check this. It matters: the
+//! step-size control amplifies any round-off change to the tolerance level (multiplying by
+//! stored reciprocals of the pivots instead of dividing made the solves 20 % faster but
+//! moved the crane's trajectory by 2.5e-5 of its scale, with 901 steps instead of 882).
 //!
 //! Measured and not taken (`examples/lu_bench`, the crane's Jacobians, h = 1e-4…1e-2):
 //! - faer 0.24's partial-pivot LU: slower at these sizes on the crane (n = 38: real 4.0 µs,
@@ -47,6 +52,13 @@
 //!   through its bookkeeping. Four trailing columns per pass instead of two: no gain.
 //! - The complex system as a real 2n×2n one on this real kernel: 3× slower (twice the
 //!   arithmetic).
+//! - (Callgrind instructions per call on the crane's Jacobians, `LU_COUNT` in lu_bench.)
+//!   Two elimination steps per pass over the trailing columns (a rank-2 update, still
+//!   bit-identical): its update loop 7.5 k instructions instead of 11.7 k, but the extra
+//!   bookkeeping ate the gain (real 54.3 k against 54.0 k). In the complex update the
+//!   explicit vectors only match LLVM's own loop (114 k either way); indexed or eight-row
+//!   variants: 116–121 k. The pivot search over a scratch slice of sizes (no bounds
+//!   checks): real 56 k against 54 k.
 
 mod complex;
 mod real;
@@ -58,39 +70,67 @@ mod tests;
 pub(crate) use complex::ComplexLu;
 pub(crate) use real::RealLu;
 
+use pulp::Simd;
+
 /// The matrix has a zero or non-finite pivot.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Singular;
 
-/// x −= l·a.
+/// x −= l·a, four rows per vector (explicit vectors: LLVM's own vectorisation ran eight
+/// rows per pass and left the last four rows of most columns to a scalar loop).
 #[inline(always)]
-fn axpy(x: &mut [f64], l: &[f64], a: f64) {
-    let l = &l[..x.len()];
-    for (x, &l) in x.iter_mut().zip(l) {
+fn axpy<S: Simd>(simd: S, x: &mut [f64], l: &[f64], a: f64) {
+    let m = x.len();
+    let (xv, xt) = S::as_mut_simd_f64s(x);
+    let (lv, lt) = S::as_simd_f64s(&l[..m]);
+    let va = simd.splat_f64s(a);
+    for (x, l) in xv.iter_mut().zip(lv) {
+        *x = simd.sub_f64s(*x, simd.mul_f64s(*l, va));
+    }
+    for (x, &l) in xt.iter_mut().zip(lt) {
         *x -= l * a;
     }
 }
 
 /// x −= l·a and y −= l·b.
 #[inline(always)]
-fn axpy2(x: &mut [f64], y: &mut [f64], l: &[f64], a: f64, b: f64) {
+fn axpy2<S: Simd>(simd: S, x: &mut [f64], y: &mut [f64], l: &[f64], a: f64, b: f64) {
     let m = l.len();
-    let (x, y) = (&mut x[..m], &mut y[..m]);
-    for i in 0..m {
-        x[i] -= l[i] * a;
-        y[i] -= l[i] * b;
+    let (xv, xt) = S::as_mut_simd_f64s(&mut x[..m]);
+    let (yv, yt) = S::as_mut_simd_f64s(&mut y[..m]);
+    let (lv, lt) = S::as_simd_f64s(l);
+    let (va, vb) = (simd.splat_f64s(a), simd.splat_f64s(b));
+    for ((x, y), l) in xv.iter_mut().zip(yv.iter_mut()).zip(lv) {
+        *x = simd.sub_f64s(*x, simd.mul_f64s(*l, va));
+        *y = simd.sub_f64s(*y, simd.mul_f64s(*l, vb));
+    }
+    for ((x, y), &l) in xt.iter_mut().zip(yt.iter_mut()).zip(lt) {
+        *x -= l * a;
+        *y -= l * b;
     }
 }
 
 /// x −= l·a for complex numbers on planes, with the operations of `num_complex`:
 /// l·a = (lr·ar − li·ai) + i(lr·ai + li·ar).
 #[inline(always)]
-fn caxpy(xr: &mut [f64], xi: &mut [f64], lr: &[f64], li: &[f64], a: (f64, f64)) {
+fn caxpy<S: Simd>(simd: S, xr: &mut [f64], xi: &mut [f64], lr: &[f64], li: &[f64], a: (f64, f64)) {
     let m = lr.len();
-    let (xr, xi, li) = (&mut xr[..m], &mut xi[..m], &li[..m]);
-    for i in 0..m {
-        xr[i] -= lr[i] * a.0 - li[i] * a.1;
-        xi[i] -= lr[i] * a.1 + li[i] * a.0;
+    let (xrv, xrt) = S::as_mut_simd_f64s(&mut xr[..m]);
+    let (xiv, xit) = S::as_mut_simd_f64s(&mut xi[..m]);
+    let (lrv, lrt) = S::as_simd_f64s(lr);
+    let (liv, lit) = S::as_simd_f64s(&li[..m]);
+    let (ar, ai) = (simd.splat_f64s(a.0), simd.splat_f64s(a.1));
+    let body = xrv.iter_mut().zip(xiv.iter_mut()).zip(lrv.iter().zip(liv));
+    for ((xr, xi), (&lr, &li)) in body {
+        let pr = simd.sub_f64s(simd.mul_f64s(lr, ar), simd.mul_f64s(li, ai));
+        let pi = simd.add_f64s(simd.mul_f64s(lr, ai), simd.mul_f64s(li, ar));
+        *xr = simd.sub_f64s(*xr, pr);
+        *xi = simd.sub_f64s(*xi, pi);
+    }
+    let tail = xrt.iter_mut().zip(xit.iter_mut()).zip(lrt.iter().zip(lit));
+    for ((xr, xi), (&lr, &li)) in tail {
+        *xr -= lr * a.0 - li * a.1;
+        *xi -= lr * a.1 + li * a.0;
     }
 }
 
@@ -98,7 +138,8 @@ fn caxpy(xr: &mut [f64], xi: &mut [f64], lr: &[f64], li: &[f64], a: (f64, f64)) 
 /// them: with tuples the loop ran 30 % slower.)
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn caxpy2(
+fn caxpy2<S: Simd>(
+    simd: S,
     xr: &mut [f64],
     xi: &mut [f64],
     yr: &mut [f64],
@@ -109,13 +150,33 @@ fn caxpy2(
     b: (f64, f64),
 ) {
     let m = lr.len();
-    let (xr, xi, li) = (&mut xr[..m], &mut xi[..m], &li[..m]);
-    let (yr, yi) = (&mut yr[..m], &mut yi[..m]);
-    for i in 0..m {
-        xr[i] -= lr[i] * a.0 - li[i] * a.1;
-        xi[i] -= lr[i] * a.1 + li[i] * a.0;
-        yr[i] -= lr[i] * b.0 - li[i] * b.1;
-        yi[i] -= lr[i] * b.1 + li[i] * b.0;
+    let (xrv, xrt) = S::as_mut_simd_f64s(&mut xr[..m]);
+    let (xiv, xit) = S::as_mut_simd_f64s(&mut xi[..m]);
+    let (yrv, yrt) = S::as_mut_simd_f64s(&mut yr[..m]);
+    let (yiv, yit) = S::as_mut_simd_f64s(&mut yi[..m]);
+    let (lrv, lrt) = S::as_simd_f64s(lr);
+    let (liv, lit) = S::as_simd_f64s(&li[..m]);
+    let (ar, ai) = (simd.splat_f64s(a.0), simd.splat_f64s(a.1));
+    let (br, bi) = (simd.splat_f64s(b.0), simd.splat_f64s(b.1));
+    let x = xrv.iter_mut().zip(xiv.iter_mut());
+    let y = yrv.iter_mut().zip(yiv.iter_mut());
+    for (((xr, xi), (yr, yi)), (&lr, &li)) in x.zip(y).zip(lrv.iter().zip(liv)) {
+        let pr = simd.sub_f64s(simd.mul_f64s(lr, ar), simd.mul_f64s(li, ai));
+        let pi = simd.add_f64s(simd.mul_f64s(lr, ai), simd.mul_f64s(li, ar));
+        *xr = simd.sub_f64s(*xr, pr);
+        *xi = simd.sub_f64s(*xi, pi);
+        let qr = simd.sub_f64s(simd.mul_f64s(lr, br), simd.mul_f64s(li, bi));
+        let qi = simd.add_f64s(simd.mul_f64s(lr, bi), simd.mul_f64s(li, br));
+        *yr = simd.sub_f64s(*yr, qr);
+        *yi = simd.sub_f64s(*yi, qi);
+    }
+    let x = xrt.iter_mut().zip(xit.iter_mut());
+    let y = yrt.iter_mut().zip(yit.iter_mut());
+    for (((xr, xi), (yr, yi)), (&lr, &li)) in x.zip(y).zip(lrt.iter().zip(lit)) {
+        *xr -= lr * a.0 - li * a.1;
+        *xi -= lr * a.1 + li * a.0;
+        *yr -= lr * b.0 - li * b.1;
+        *yi -= lr * b.1 + li * b.0;
     }
 }
 
@@ -213,13 +274,6 @@ fn widen(lo: usize, hi: usize, first: usize, end: usize) -> (usize, usize) {
     (hi.saturating_sub(len).max(first), hi)
 }
 
-/// Columns j1 < j2 of the column-major `cols` with n rows.
-#[inline(always)]
-fn two_columns(cols: &mut [f64], n: usize, j1: usize, j2: usize) -> (&mut [f64], &mut [f64]) {
-    let (a, b) = cols.split_at_mut(j2 * n);
-    (&mut a[j1 * n..(j1 + 1) * n], &mut b[..n])
-}
-
 /// Where the zeros of the factors are, for the solves.
 #[derive(Clone, Debug)]
 struct Pattern {
@@ -230,8 +284,6 @@ struct Pattern {
     hi: Vec<usize>,
     /// Column k of U is zero above row top[k].
     top: Vec<usize>,
-    /// Scratch: the trailing columns updated at the current step.
-    cols: Vec<usize>,
 }
 
 impl Pattern {
@@ -241,7 +293,6 @@ impl Pattern {
             lo: vec![0; n],
             hi: vec![0; n],
             top: vec![0; n],
-            cols: vec![0; n],
         }
     }
 }

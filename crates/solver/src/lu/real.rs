@@ -2,7 +2,7 @@
 
 use pulp::{Arch, Simd, WithSimd};
 
-use super::{axpy, axpy2, axpy_twice, nonzero_rows, pivot, two_columns, widen, Pattern, Singular};
+use super::{axpy, axpy2, axpy_twice, nonzero_rows, pivot, widen, Pattern, Singular};
 
 /// A real n×n matrix and, after [`RealLu::factor`], its factors P·A = L·U in place.
 #[derive(Clone, Debug)]
@@ -45,15 +45,15 @@ impl RealLu {
         impl WithSimd for Op<'_> {
             type Output = Result<(), Singular>;
             #[inline(always)]
-            fn with_simd<S: Simd>(self, _: S) -> Self::Output {
-                self.0.factor_kernel()
+            fn with_simd<S: Simd>(self, simd: S) -> Self::Output {
+                self.0.factor_kernel(simd)
             }
         }
         self.arch.dispatch(Op(self))
     }
 
     #[inline(always)]
-    fn factor_kernel(&mut self) -> Result<(), Singular> {
+    fn factor_kernel<S: Simd>(&mut self, simd: S) -> Result<(), Singular> {
         let n = self.n;
         let pat = &mut self.pat;
         for k in 0..n {
@@ -61,12 +61,7 @@ impl RealLu {
             let colk = &mut left[k * n..];
             let p = k + pivot(n - k, |i| colk[k + i].abs()).ok_or(Singular)?;
             pat.piv[k] = p;
-            if p != k {
-                colk.swap(k, p);
-                for colj in right.chunks_exact_mut(n) {
-                    colj.swap(k, p);
-                }
-            }
+            colk.swap(k, p);
             let inv = 1.0 / colk[k];
             for v in &mut colk[k + 1..] {
                 *v *= inv;
@@ -76,26 +71,35 @@ impl RealLu {
             pat.lo[k] = lo;
             pat.hi[k] = hi;
             if lo == hi {
+                if p != k {
+                    for colj in right.chunks_exact_mut(n) {
+                        colj.swap(k, p);
+                    }
+                }
                 continue;
             }
-            // The trailing columns with a non-zero (not NaN) in row k, gathered without
-            // branches; updated two at a time.
-            let mut count = 0;
-            for (j, colj) in right.chunks_exact(n).enumerate() {
-                pat.cols[count] = j;
-                count += usize::from(colj[k].abs() > 0.0);
-            }
+            // One pass over the trailing columns: rows k and p interchanged, and those with
+            // a non-zero (not NaN) in row k updated, two at a time (the first of a pair
+            // waits in `pending`).
             let l = &colk[lo..hi];
-            let mut pairs = pat.cols[..count].chunks_exact(2);
-            for pair in &mut pairs {
-                let (x, y) = two_columns(right, n, pair[0], pair[1]);
-                let (a, b) = (x[k], y[k]);
-                axpy2(&mut x[lo..hi], &mut y[lo..hi], l, a, b);
+            let mut pending: Option<&mut [f64]> = None;
+            for colj in right.chunks_exact_mut(n) {
+                if p != k {
+                    colj.swap(k, p);
+                }
+                if colj[k].abs() > 0.0 {
+                    match pending.take() {
+                        None => pending = Some(colj),
+                        Some(x) => {
+                            let (a, b) = (x[k], colj[k]);
+                            axpy2(simd, &mut x[lo..hi], &mut colj[lo..hi], l, a, b);
+                        }
+                    }
+                }
             }
-            if let [j] = *pairs.remainder() {
-                let x = &mut right[j * n..(j + 1) * n];
+            if let Some(x) = pending {
                 let a = x[k];
-                axpy(&mut x[lo..hi], l, a);
+                axpy(simd, &mut x[lo..hi], l, a);
             }
         }
         for k in 0..n {
@@ -111,15 +115,15 @@ impl RealLu {
         impl WithSimd for Op<'_> {
             type Output = ();
             #[inline(always)]
-            fn with_simd<S: Simd>(self, _: S) {
-                self.0.solve_kernel(self.1);
+            fn with_simd<S: Simd>(self, simd: S) {
+                self.0.solve_kernel(simd, self.1);
             }
         }
         self.arch.dispatch(Op(self, b));
     }
 
     #[inline(always)]
-    fn solve_kernel(&self, b: &mut [f64]) {
+    fn solve_kernel<S: Simd>(&self, simd: S, b: &mut [f64]) {
         let (n, a, pat) = (self.n, &self.a, &self.pat);
         // L y = P b, interchanging as the factorisation did.
         for k in 0..n {
@@ -127,7 +131,7 @@ impl RealLu {
             let bk = b[k];
             if bk != 0.0 {
                 let (lo, hi) = (pat.lo[k], pat.hi[k]);
-                axpy(&mut b[lo..hi], &a[k * n + lo..k * n + hi], bk);
+                axpy(simd, &mut b[lo..hi], &a[k * n + lo..k * n + hi], bk);
             }
         }
         // U x = y, column-oriented, columns k1 = k0 + 1 and k0 in one pass over the rows
