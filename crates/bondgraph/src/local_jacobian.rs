@@ -520,10 +520,18 @@ mod tests {
         assert_eq!(s.row(Slot::Flow(44), 0), 0);
         assert_eq!(s.row(Slot::Output(0), 1), 4);
         assert_eq!(s.row(Slot::Effort(7), 0), 46);
-        for unwritten in [Slot::Flow(7), Slot::Effort(0), Slot::Input(0), Slot::Flow(45)] {
+        for unwritten in [
+            Slot::Flow(7),
+            Slot::Effort(0),
+            Slot::Input(0),
+            Slot::Flow(45),
+        ] {
             let r = std::panic::catch_unwind(|| s.row(unwritten, 0));
             assert!(r.is_err(), "{unwritten:?} is not written");
         }
-        assert!(std::panic::catch_unwind(|| LocalShape::derivatives(&layout).row(Slot::Flow(0), 0)).is_err());
+        assert!(
+            std::panic::catch_unwind(|| LocalShape::derivatives(&layout).row(Slot::Flow(0), 0))
+                .is_err()
+        );
     }
 }
