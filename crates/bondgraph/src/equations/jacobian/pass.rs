@@ -66,8 +66,9 @@ fn apply(g: &mut [f64], runs: &[Run], c: f64) {
     }
 }
 
-/// Entries are scanned for nonzeros this many at a time.
+/// Entries of a block of at least `CHUNKED_MIN` are scanned for nonzeros `CHUNK` at a time.
 const CHUNK: usize = 8;
+const CHUNKED_MIN: usize = 64;
 
 /// Whether every value is ±0 (one test for a chunk of a mostly empty local block).
 #[inline]
@@ -223,9 +224,12 @@ impl<'a> Pass<'a> {
                 Storage::Dense(Some(mask)) => Some(mask),
                 _ => None,
             };
-            for start in (0..e.len).step_by(CHUNK) {
-                let end = e.len.min(start + CHUNK);
-                if all_zero(&w.local[start..end]) {
+            // small blocks (mostly nonzero) are read entry by entry
+            let chunked = e.len >= CHUNKED_MIN;
+            let step = if chunked { CHUNK } else { e.len.max(1) };
+            for start in (0..e.len).step_by(step) {
+                let end = e.len.min(start + step);
+                if chunked && all_zero(&w.local[start..end]) {
                     continue;
                 }
                 for i in start..end {
