@@ -18,8 +18,15 @@ pub struct LocalShape {
     pub(crate) n_cols: usize,
     /// Per written slot: (slot, first row, dimension).
     rows: Vec<(Slot, usize, usize)>,
+    /// The (first row, dimension) of each slot, first row [`NO_ROW`] if it is not written:
+    /// efforts of ports 0..P, then their flows, then the outputs (a direct look-up for
+    /// [`row`](Self::row)).
+    first_row: Vec<(usize, usize)>,
     n_rows: usize,
 }
+
+/// [`LocalShape::first_row`] of a slot the stage does not write.
+const NO_ROW: usize = usize::MAX;
 
 impl LocalShape {
     /// The columns of an element with this layout, no rows yet.
@@ -42,8 +49,23 @@ impl LocalShape {
             n_states: layout.n_states,
             n_cols: col + layout.n_states,
             rows: Vec::new(),
+            first_row: Vec::new(),
             n_rows: 0,
         }
+    }
+
+    /// Index of `slot` in [`first_row`](Self::first_row) (`None` for an input, or a port or
+    /// output beyond the shape's).
+    #[inline]
+    fn slot_index(&self, slot: Slot) -> Option<usize> {
+        let np = self.ports.len();
+        let i = match slot {
+            Slot::Effort(p) if p < np => p,
+            Slot::Flow(p) if p < np => np + p,
+            Slot::Output(i) => 2 * np + i,
+            _ => return None,
+        };
+        (i < self.first_row.len()).then_some(i)
     }
 
     /// The shape for a stage of an element with this layout that writes `writes` (in order).
@@ -54,6 +76,7 @@ impl LocalShape {
     #[must_use]
     pub fn stage(layout: &Layout, writes: &[Slot]) -> Self {
         let mut shape = Self::columns(layout);
+        shape.first_row = vec![(NO_ROW, 0); 2 * layout.ports.len() + layout.outputs.len()];
         let mut row = 0;
         for &slot in writes {
             let dim = match slot {
@@ -62,6 +85,11 @@ impl LocalShape {
                 Slot::Input(_) => panic!("a stage cannot write a signal input"),
             };
             shape.rows.push((slot, row, dim));
+            if let Some(i) = shape.slot_index(slot) {
+                if shape.first_row[i].0 == NO_ROW {
+                    shape.first_row[i] = (row, dim);
+                }
+            }
             row += dim;
         }
         shape.n_rows = row;
@@ -142,12 +170,13 @@ impl LocalShape {
     #[must_use]
     #[inline]
     pub fn row(&self, slot: Slot, k: usize) -> usize {
-        match self.rows.iter().find(|r| r.0 == slot) {
-            Some(&(_, r, dim)) => {
+        // r = first_row[slot]: one look-up, not a search of the written slots
+        match self.slot_index(slot).map(|i| self.first_row[i]) {
+            Some((r, dim)) if r != NO_ROW => {
                 debug_assert!(k < dim, "component {k} of a {dim}-slot");
                 r + k
             }
-            None => panic!("the stage does not write {slot:?}"),
+            _ => panic!("the stage does not write {slot:?}"),
         }
     }
 
@@ -456,5 +485,53 @@ mod tests {
         );
         assert_eq!((s.n_rows(), s.len()), (5, 60));
         assert_eq!(LocalShape::derivatives(&layout).n_rows(), 2);
+    }
+
+    /// The direct look-up of `row` agrees with the written slots' order on a wide junction
+    /// (45 ports, the common flow written to 44 of them out of port order), and a slot the
+    /// stage does not write still panics.
+    #[test]
+    fn row_lookup_on_many_rows() {
+        let ports = (0..45)
+            .map(|p| PortLayout {
+                offset: p,
+                dim: 1,
+                sign: if p % 2 == 0 { 1.0 } else { -1.0 },
+                causality: PortCausality::FlowOut,
+            })
+            .collect();
+        let layout = Layout {
+            ports,
+            inputs: vec![],
+            outputs: vec![(0, 2)],
+            state_offset: 0,
+            n_states: 0,
+        };
+        let mut writes: Vec<Slot> = (0..45).rev().filter(|&p| p != 7).map(Slot::Flow).collect();
+        writes.insert(3, Slot::Output(0));
+        writes.push(Slot::Effort(7));
+        let s = LocalShape::stage(&layout, &writes);
+        assert_eq!(s.n_rows(), 47);
+        for &(slot, first, dim) in s.rows() {
+            for k in 0..dim {
+                assert_eq!(s.row(slot, k), first + k, "{slot:?}");
+            }
+        }
+        assert_eq!(s.row(Slot::Flow(44), 0), 0);
+        assert_eq!(s.row(Slot::Output(0), 1), 4);
+        assert_eq!(s.row(Slot::Effort(7), 0), 46);
+        for unwritten in [
+            Slot::Flow(7),
+            Slot::Effort(0),
+            Slot::Input(0),
+            Slot::Flow(45),
+        ] {
+            let r = std::panic::catch_unwind(|| s.row(unwritten, 0));
+            assert!(r.is_err(), "{unwritten:?} is not written");
+        }
+        assert!(
+            std::panic::catch_unwind(|| LocalShape::derivatives(&layout).row(Slot::Flow(0), 0))
+                .is_err()
+        );
     }
 }

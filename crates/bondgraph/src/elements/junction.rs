@@ -40,6 +40,16 @@ fn two_stages(
 /// Copy port `d`'s values (efforts of a 0-, flows of a 1-junction) to every other port.
 fn share(values: &mut [f64], layout: &Layout, d: usize) {
     let (from, dim) = (layout.ports[d].offset, layout.ports[d].dim);
+    if dim == 1 {
+        // scalar bonds (most junctions): plain stores, no memmove per port
+        let v = values[from];
+        for (p, port) in layout.ports.iter().enumerate() {
+            if p != d {
+                values[port.offset] = v;
+            }
+        }
+        return;
+    }
     for (p, port) in layout.ports.iter().enumerate() {
         if p != d {
             values.copy_within(from..from + dim, port.offset);
@@ -55,6 +65,17 @@ fn balance(values: &mut [f64], layout: &Layout, d: usize) {
         layout.ports[d].dim,
         layout.ports[d].sign,
     );
+    if dim == 1 {
+        // scalar bonds: the same sum, in the same order, in a register
+        let mut sum = 0.0;
+        for (p, port) in layout.ports.iter().enumerate() {
+            if p != d {
+                sum += -sd * port.sign * values[port.offset];
+            }
+        }
+        values[to] = sum;
+        return;
+    }
     values[to..to + dim].fill(0.0);
     for (p, port) in layout.ports.iter().enumerate() {
         if p != d {

@@ -79,7 +79,8 @@ impl StateEquations {
         if jac.shape() != (n, n) {
             *jac = DMatrix::zeros(n, n);
         }
-        jac.fill(0.0);
+        // the storage as one slice: a memset, not nalgebra's element iterator
+        jac.as_mut_slice().fill(0.0);
         self.jacobian_into(t, x, &mut Out::Dense(jac));
     }
 

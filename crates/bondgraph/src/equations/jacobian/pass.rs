@@ -54,11 +54,26 @@ fn apply(g: &mut [f64], runs: &[Run], c: f64) {
     for run in runs {
         let (d, s, len) = (run.d as usize, run.s as usize, run.len as usize);
         debug_assert!(s + len <= d, "a run's source lies before its destination");
+        if len == 1 {
+            // a state's unit gradient, or one isolated column: no slices to set up
+            g[d] += c * g[s];
+            continue;
+        }
         let (src, dst) = g.split_at_mut(d);
         for (a, b) in dst[..len].iter_mut().zip(&src[s..s + len]) {
             *a += c * b;
         }
     }
+}
+
+/// Entries of a block of at least `CHUNKED_MIN` are scanned for nonzeros `CHUNK` at a time.
+const CHUNK: usize = 8;
+const CHUNKED_MIN: usize = 64;
+
+/// Whether every value is ±0 (one test for a chunk of a mostly empty local block).
+#[inline]
+fn all_zero(values: &[f64]) -> bool {
+    values.iter().fold(0u64, |acc, v| acc | v.to_bits()) << 1 == 0
 }
 
 /// One Jacobian pass: the plan's values and the gradient workspace.
@@ -209,21 +224,30 @@ impl<'a> Pass<'a> {
                 Storage::Dense(Some(mask)) => Some(mask),
                 _ => None,
             };
-            for i in 0..e.len {
-                let v = w.local[i];
-                if v == 0.0 {
+            // small blocks (mostly nonzero) are read entry by entry
+            let chunked = e.len >= CHUNKED_MIN;
+            let step = if chunked { CHUNK } else { e.len.max(1) };
+            for start in (0..e.len).step_by(step) {
+                let end = e.len.min(start + step);
+                if chunked && all_zero(&w.local[start..end]) {
                     continue;
                 }
-                w.local[i] = 0.0;
-                if !gives {
-                    continue;
+                for i in start..end {
+                    let v = w.local[i];
+                    if v == 0.0 {
+                        continue;
+                    }
+                    w.local[i] = 0.0;
+                    if !gives {
+                        continue;
+                    }
+                    let run = e.first[i] as usize..e.first[i + 1] as usize;
+                    if run.is_empty() && mask.is_some_and(|m| !m[i]) {
+                        // outside a wide block's structure
+                        self.stale = true;
+                    }
+                    apply(&mut w.g, &updates[run], v * e.fac[i]);
                 }
-                let run = e.first[i] as usize..e.first[i + 1] as usize;
-                if run.is_empty() && mask.is_some_and(|m| !m[i]) {
-                    // outside a wide block's structure
-                    self.stale = true;
-                }
-                apply(&mut w.g, &updates[run], v * e.fac[i]);
             }
         }
         if gives {
@@ -283,12 +307,22 @@ impl<'a> Pass<'a> {
 /// The Jacobian's rows, from the gradients of a pass, into `out` (which the caller zeroed;
 /// an entry a sparse pattern lacks — only after the plan was widened — is dropped).
 pub(super) fn write_rows(code: &Compiled, w: &Work, out: &mut Out<'_>) {
-    for &(i, span) in &code.rows {
-        for q in span.range() {
-            let (j, v) = (code.cols[q] as usize, w.g[q]);
-            match out {
-                Out::Dense(jac) => jac[(i, j)] = v,
-                Out::Sparse(pattern, values) => {
+    match out {
+        Out::Dense(jac) => {
+            // column-major: entry (i, j) at j·n + i
+            let n = jac.nrows();
+            let values = jac.as_mut_slice();
+            for &(i, span) in &code.rows {
+                let q = span.range();
+                for (&j, &v) in code.cols[q.clone()].iter().zip(&w.g[q]) {
+                    values[j as usize * n + i] = v;
+                }
+            }
+        }
+        Out::Sparse(pattern, values) => {
+            for &(i, span) in &code.rows {
+                for q in span.range() {
+                    let (j, v) = (code.cols[q] as usize, w.g[q]);
                     if v != 0.0 {
                         if let Some(slot) = pattern.slot(i, j) {
                             values[slot] = v;
