@@ -113,9 +113,10 @@ fn nothing_allocates_in_the_solver_loop() {
     sparse_newton_iterations_do_not_allocate();
 }
 
-/// On the sparse path (faer's sparse LU) the solves of the Newton iterations take their
-/// scratch from a buffer sized once: what allocates at all is the numeric factorisation,
-/// which may grow its vectors, so a run allocates far less often than it iterates.
+/// On the sparse path the refactorisation on the stored patterns and the triangular solves
+/// work in storage sized once (`bg_solver::sparse`); what allocates at all is faer's pivoted
+/// factorisation when a stored pivot fails (Van der Pol changes its pivot order often: 27
+/// allocations in 224 factorisations and 655 Newton iterations here).
 fn sparse_newton_iterations_do_not_allocate() {
     use bondgraph::radau::{LinearAlgebra, Radau5, RadauOptions};
     let mut sys = VanDerPol;
