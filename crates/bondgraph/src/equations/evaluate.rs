@@ -29,6 +29,22 @@ impl StateEquations {
         signals: &mut [f64],
         dx: &mut [f64],
     ) {
+        self.run_stages(order, t, x, effort, flow, signals);
+        let with_states = (0..self.layouts.len()).filter(|&id| self.layouts[id].n_states > 0);
+        self.derivatives_of(with_states, t, x, effort, flow, signals, dx);
+    }
+
+    /// Run the stages `order` (element, stage) at (t, x), in that order.
+    #[inline]
+    pub(super) fn run_stages(
+        &self,
+        order: &[(ElementId, usize)],
+        t: f64,
+        x: &[f64],
+        effort: &mut [f64],
+        flow: &mut [f64],
+        signals: &mut [f64],
+    ) {
         for &(id, stage) in order {
             let mut io = Io {
                 t,
@@ -40,21 +56,36 @@ impl StateEquations {
             };
             self.graph.node(id).element.eval(stage, &mut io);
         }
-        for (id, l) in self.layouts.iter().enumerate() {
-            if l.n_states > 0 {
-                let io = Io {
-                    t,
-                    x,
-                    effort,
-                    flow,
-                    signals,
-                    layout: l,
-                };
-                self.graph
-                    .node(id)
-                    .element
-                    .derivatives(&io, &mut dx[l.state_offset..l.state_offset + l.n_states]);
-            }
+    }
+
+    /// The state derivatives of the elements `ids` (each with states) into their slices of
+    /// `dx`, from the values the stages left.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub(super) fn derivatives_of(
+        &self,
+        ids: impl Iterator<Item = ElementId>,
+        t: f64,
+        x: &[f64],
+        effort: &mut [f64],
+        flow: &mut [f64],
+        signals: &mut [f64],
+        dx: &mut [f64],
+    ) {
+        for id in ids {
+            let l = &self.layouts[id];
+            let io = Io {
+                t,
+                x,
+                effort,
+                flow,
+                signals,
+                layout: l,
+            };
+            self.graph
+                .node(id)
+                .element
+                .derivatives(&io, &mut dx[l.state_offset..l.state_offset + l.n_states]);
         }
     }
 

@@ -6,7 +6,7 @@
 
 use super::{Probe, StateEquations, Var, Workspace};
 use crate::bond::{ElementId, PortCausality};
-use crate::element::{Io, Slot};
+use crate::element::Slot;
 
 /// What [`StateEquations::evaluate_only`] runs for a set of probes: the stages that compute
 /// them, in plan order, and the elements whose state derivatives they read. Made once by
@@ -93,46 +93,17 @@ impl StateEquations {
             signals,
             dx,
         } = &mut *ws;
-        for &(id, stage) in &subset.stages {
-            let mut io = Io {
-                t,
-                x,
-                effort,
-                flow,
-                signals,
-                layout: &self.layouts[id],
-            };
-            self.graph.node(id).element.eval(stage, &mut io);
-        }
-        for &id in &subset.derivatives {
-            let l = &self.layouts[id];
-            let io = Io {
-                t,
-                x,
-                effort,
-                flow,
-                signals,
-                layout: l,
-            };
-            self.graph
-                .node(id)
-                .element
-                .derivatives(&io, &mut dx[l.state_offset..l.state_offset + l.n_states]);
-        }
+        self.run_stages(&subset.stages, t, x, effort, flow, signals);
+        let ids = subset.derivatives.iter().copied();
+        self.derivatives_of(ids, t, x, effort, flow, signals, dx);
     }
 
     /// Forget every value evaluated so far (efforts, flows, signals and derivatives become
     /// NaN): a probe then reads NaN unless its stages run again, which shows a stage
     /// [`subset`](Self::subset) left out.
     pub fn forget(&self) {
-        let mut ws = self.ws.borrow_mut();
-        let Workspace {
-            effort,
-            flow,
-            signals,
-            dx,
-        } = &mut *ws;
-        for v in [effort, flow, signals, dx] {
+        let ws = &mut *self.ws.borrow_mut();
+        for v in [&mut ws.effort, &mut ws.flow, &mut ws.signals, &mut ws.dx] {
             v.fill(f64::NAN);
         }
     }
