@@ -416,6 +416,7 @@ impl Clone for PoseFrames<'_> {
 
 impl Deref for PoseFrames<'_> {
     type Target = Frames;
+    #[inline(always)]
     fn deref(&self) -> &Frames {
         match self {
             Self::Owned(f) => f,
@@ -443,12 +444,14 @@ impl<'a> Pose<'a> {
     }
     /// `R_i^0 v`: a vector in the coordinates of frame i expressed in frame 0.
     #[must_use]
+    #[inline]
     pub fn to_base(&self, i: usize, v: &Vector2<f64>) -> Vector2<f64> {
         let (c, s) = self.frames.cs[i];
         Vector2::new(c * v.x - s * v.y, s * v.x + c * v.y)
     }
     /// `R_0^i v`: a vector in frame 0 expressed in the coordinates of frame i.
     #[must_use]
+    #[inline]
     pub fn to_frame(&self, i: usize, v: &Vector2<f64>) -> Vector2<f64> {
         let (c, s) = self.frames.cs[i];
         Vector2::new(c * v.x + s * v.y, -s * v.x + c * v.y)
@@ -474,6 +477,7 @@ impl<'a> Pose<'a> {
     /// Position of joint i (origin of frame i) in frame 0; `origin(n_links)` is the end of
     /// the last chord.
     #[must_use]
+    #[inline]
     pub fn origin(&self, i: usize) -> Vector2<f64> {
         self.frames.origin[i]
     }
@@ -481,6 +485,7 @@ impl<'a> Pose<'a> {
     /// ([`geometric_stiffening`](crate::geometric_stiffening)): `o_i + Σ_{j<i} s_j e_j`; the
     /// paper's [`origin`](Self::origin) without it. Pins turn about these points.
     #[must_use]
+    #[inline]
     pub fn pivot(&self, i: usize) -> Vector2<f64> {
         match self.frames.shift.get(i) {
             Some(d) => self.frames.origin[i] + d,
@@ -528,6 +533,7 @@ impl<'a> Pose<'a> {
     }
     /// `(cos φ_i, sin φ_i)`.
     #[must_use]
+    #[inline]
     pub fn cos_sin(&self, i: usize) -> (f64, f64) {
         self.frames.cs[i]
     }
@@ -535,7 +541,7 @@ impl<'a> Pose<'a> {
     /// (zero for j = i). The moment arm of a point r of link i about joint j is
     /// `d_j = c_j + (x, w)` (eq. 35).
     #[must_use]
-    #[inline]
+    #[inline(always)]
     pub fn chord_offset(&self, i: usize, j: usize) -> Vector2<f64> {
         if j <= i {
             self.frames.chord[i * (i + 1) / 2 + j]
