@@ -11,8 +11,8 @@
 //! frame 0 for i = 1, at the end of link i−1's chord otherwise; its x axis runs along link
 //! i's chord at the angle `φ_i = q_1 + … + q_i` from x₀.
 
-use std::borrow::Cow;
-use std::cell::RefCell;
+use std::cell::{Ref, RefCell};
+use std::ops::Deref;
 
 use nalgebra::Vector2;
 
@@ -52,7 +52,8 @@ pub struct PlanarArm {
     /// Whether any link keeps its axial shortening.
     stiffening: bool,
     /// The frames at the last configuration asked for with [`pose_in`](Self::pose_in): the
-    /// elements of one arm all read the same q, so one of them computes them, the others copy.
+    /// elements of one arm all read the same q, so one of them computes them, the others read
+    /// them in place.
     shared: RefCell<SharedFrames>,
 }
 
@@ -243,46 +244,56 @@ impl PlanarArm {
         Pose {
             arm: self,
             q,
-            frames: Cow::Owned(frames),
+            frames: PoseFrames::Owned(frames),
         }
     }
 
-    /// The configuration at `q`, computed into `frames` (no allocation once `frames` has
-    /// room, e.g. from [`frames`](Self::frames)).
+    /// The configuration at `q`: the arm's shared frames if they are at q (bit for bit), else
+    /// computed there first; computed into `frames` only while a pose at another q still reads
+    /// the shared ones. The same numbers as [`fill`](Self::fill) either way, and no
+    /// allocation once `frames` has room (e.g. from [`frames`](Self::frames)).
     ///
     /// # Panics
     /// If `q.len() != self.n()`.
     #[must_use]
     pub fn pose_in<'a>(&'a self, q: &'a [f64], frames: &'a mut Frames) -> Pose<'a> {
-        self.fill_shared(q, frames);
+        let frames = match self.shared_at(q) {
+            Some(shared) => PoseFrames::Shared(shared),
+            None => {
+                self.fill(q, frames);
+                PoseFrames::Borrowed(frames)
+            }
+        };
         Pose {
             arm: self,
             q,
-            frames: Cow::Borrowed(frames),
+            frames,
         }
     }
 
-    /// The frames at q into `f`: copied from the shared ones if they are at q (bit for bit),
-    /// else computed there first. The same numbers as [`fill`](Self::fill), without
-    /// allocating once `f` has room.
-    fn fill_shared(&self, q: &[f64], f: &mut Frames) {
-        let mut shared = self.shared.borrow_mut();
-        let SharedFrames {
-            q: at,
-            valid,
-            frames,
-        } = &mut *shared;
-        let same = *valid
-            && at.len() == q.len()
-            && at.iter().zip(q).all(|(a, b)| a.to_bits() == b.to_bits());
-        if !same {
+    /// The shared frames, at q; `None` if they are elsewhere and cannot be moved (a pose
+    /// still reads them).
+    fn shared_at(&self, q: &[f64]) -> Option<Ref<'_, Frames>> {
+        if let Ok(shared) = self.shared.try_borrow() {
+            if shared.is_at(q) {
+                return Some(Ref::map(shared, |s| &s.frames));
+            }
+        }
+        {
+            let mut shared = self.shared.try_borrow_mut().ok()?;
+            let SharedFrames {
+                q: at,
+                valid,
+                frames,
+            } = &mut *shared;
             *valid = false;
             self.fill(q, frames);
             at.clear();
             at.extend_from_slice(q);
             *valid = true;
         }
-        f.copy_from(frames);
+        let shared = self.shared.try_borrow().ok()?;
+        Some(Ref::map(shared, |s| &s.frames))
     }
 
     fn fill(&self, q: &[f64], f: &mut Frames) {
@@ -337,6 +348,18 @@ impl PlanarArm {
     }
 }
 
+impl SharedFrames {
+    fn is_at(&self, q: &[f64]) -> bool {
+        self.valid
+            && self.q.len() == q.len()
+            && self
+                .q
+                .iter()
+                .zip(q)
+                .all(|(a, b)| a.to_bits() == b.to_bits())
+    }
+}
+
 /// The frames of an arm at one configuration: chord angles φ_i, their cosines and sines,
 /// and the joint positions. A [`Pose`] owns or borrows them.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -363,15 +386,6 @@ impl Frames {
             chord: Vec::with_capacity(nl * (nl + 1) / 2),
         }
     }
-
-    /// `self ← other` in the buffers already allocated (no allocation once they have room).
-    fn copy_from(&mut self, other: &Self) {
-        self.phi.clone_from(&other.phi);
-        self.cs.clone_from(&other.cs);
-        self.origin.clone_from(&other.origin);
-        self.shift.clone_from(&other.shift);
-        self.chord.clone_from(&other.chord);
-    }
 }
 
 /// The arm at one configuration q: chord angles, joint positions, deflections.
@@ -379,7 +393,37 @@ impl Frames {
 pub struct Pose<'a> {
     arm: &'a PlanarArm,
     q: &'a [f64],
-    frames: Cow<'a, Frames>,
+    frames: PoseFrames<'a>,
+}
+
+/// The frames a [`Pose`] reads: its own, a caller's, or the arm's shared ones.
+#[derive(Debug)]
+enum PoseFrames<'a> {
+    Owned(Frames),
+    Borrowed(&'a Frames),
+    Shared(Ref<'a, Frames>),
+}
+
+impl Clone for PoseFrames<'_> {
+    fn clone(&self) -> Self {
+        match self {
+            Self::Owned(f) => Self::Owned(f.clone()),
+            Self::Borrowed(f) => Self::Borrowed(f),
+            Self::Shared(f) => Self::Shared(Ref::clone(f)),
+        }
+    }
+}
+
+impl Deref for PoseFrames<'_> {
+    type Target = Frames;
+    #[inline(always)]
+    fn deref(&self) -> &Frames {
+        match self {
+            Self::Owned(f) => f,
+            Self::Borrowed(f) => f,
+            Self::Shared(f) => f,
+        }
+    }
 }
 
 impl<'a> Pose<'a> {
@@ -400,12 +444,14 @@ impl<'a> Pose<'a> {
     }
     /// `R_i^0 v`: a vector in the coordinates of frame i expressed in frame 0.
     #[must_use]
+    #[inline]
     pub fn to_base(&self, i: usize, v: &Vector2<f64>) -> Vector2<f64> {
         let (c, s) = self.frames.cs[i];
         Vector2::new(c * v.x - s * v.y, s * v.x + c * v.y)
     }
     /// `R_0^i v`: a vector in frame 0 expressed in the coordinates of frame i.
     #[must_use]
+    #[inline]
     pub fn to_frame(&self, i: usize, v: &Vector2<f64>) -> Vector2<f64> {
         let (c, s) = self.frames.cs[i];
         Vector2::new(c * v.x + s * v.y, -s * v.x + c * v.y)
@@ -431,6 +477,7 @@ impl<'a> Pose<'a> {
     /// Position of joint i (origin of frame i) in frame 0; `origin(n_links)` is the end of
     /// the last chord.
     #[must_use]
+    #[inline]
     pub fn origin(&self, i: usize) -> Vector2<f64> {
         self.frames.origin[i]
     }
@@ -438,6 +485,7 @@ impl<'a> Pose<'a> {
     /// ([`geometric_stiffening`](crate::geometric_stiffening)): `o_i + Σ_{j<i} s_j e_j`; the
     /// paper's [`origin`](Self::origin) without it. Pins turn about these points.
     #[must_use]
+    #[inline]
     pub fn pivot(&self, i: usize) -> Vector2<f64> {
         match self.frames.shift.get(i) {
             Some(d) => self.frames.origin[i] + d,
@@ -485,6 +533,7 @@ impl<'a> Pose<'a> {
     }
     /// `(cos φ_i, sin φ_i)`.
     #[must_use]
+    #[inline]
     pub fn cos_sin(&self, i: usize) -> (f64, f64) {
         self.frames.cs[i]
     }
@@ -492,7 +541,7 @@ impl<'a> Pose<'a> {
     /// (zero for j = i). The moment arm of a point r of link i about joint j is
     /// `d_j = c_j + (x, w)` (eq. 35).
     #[must_use]
-    #[inline]
+    #[inline(always)]
     pub fn chord_offset(&self, i: usize, j: usize) -> Vector2<f64> {
         if j <= i {
             self.frames.chord[i * (i + 1) / 2 + j]
@@ -542,46 +591,4 @@ pub(crate) fn z_cross(v: &Vector2<f64>) -> Vector2<f64> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn coordinates_and_frames_of_the_knuckle_boom() {
-        let l1 = Link::beam(10.0, 210e9, 7850.0, 0.0264, 5.89e-4)
-            .unwrap()
-            .with_sine_modes(3)
-            .unwrap();
-        let l2 = Link::beam(8.0, 210e9, 7850.0, 0.0264, 5.89e-4)
-            .unwrap()
-            .with_sine_modes(3)
-            .unwrap();
-        let l3 = Link::pendulum(6.0, 5000.0).unwrap();
-        let arm = PlanarArm::new(vec![l1, l2, l3], 9.81).unwrap();
-        assert_eq!(arm.n(), 9);
-        assert_eq!(arm.coordinate_names()[3], "qb1_1");
-        assert_eq!(arm.modal_offset(1), 6);
-        let pi = std::f64::consts::PI;
-        let q = [0.0, -2.0 * pi / 3.0, pi / 6.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
-        let pose = arm.pose(&q);
-        assert!((pose.origin(1) - Vector2::new(10.0, 0.0)).norm() < 1e-12);
-        assert!((pose.origin(2) - Vector2::new(6.0, -8.0 * (pi / 3.0).sin())).norm() < 1e-12);
-        // the pendulum hangs straight down
-        assert!((pose.chord_angle(2) + pi / 2.0).abs() < 1e-12);
-        assert!(arm.station(3, 1.0).is_err());
-        assert!(arm.station(0, 10.5).is_err());
-        // the frames shared by the arm's elements: the same bits as computed afresh, whatever
-        // the order of the configurations asked for
-        let q2: Vec<f64> = q.iter().map(|v| v + 0.3).collect();
-        let mut frames = [arm.frames(), arm.frames()];
-        for (k, qa) in [&q[..], &q2[..], &q[..]].into_iter().enumerate() {
-            let (shared, fresh) = (arm.pose_in(qa, &mut frames[k % 2]), arm.pose(qa));
-            assert_eq!(shared.frames.as_ref(), fresh.frames.as_ref());
-            assert_eq!(shared.chord_offset(2, 0), pose_chord(&fresh, 2, 0));
-        }
-    }
-
-    /// `c_j` computed directly.
-    fn pose_chord(p: &Pose<'_>, i: usize, j: usize) -> Vector2<f64> {
-        p.to_frame(i, &(p.origin(i) - p.origin(j)))
-    }
-}
+mod tests;

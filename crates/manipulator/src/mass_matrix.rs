@@ -46,14 +46,14 @@ impl ArmKinematics<'_> {
             let g = arm.shape_integrals(i);
             let o = arm.modal_offset(i);
             let qb = self.pose.modal(i);
-            let d = g.deflection_moments(qb, qb);
+            let (w, w_w) = g.deflection_and_square(qb);
             let (mass, s1, s2) = (g.mass(), g.first_moment(), g.second_moment());
-            let common = s2 + d.w_w + g.rotary();
+            let common = s2 + w_w + g.rotary();
             for j in 0..=i {
                 let cj = self.pose.chord_offset(i, j);
                 for l in 0..=j {
                     let cl = self.pose.chord_offset(i, l);
-                    let v = mass * cj.dot(&cl) + (cj.x + cl.x) * s1 + (cj.y + cl.y) * d.w + common;
+                    let v = mass * cj.dot(&cl) + (cj.x + cl.x) * s1 + (cj.y + cl.y) * w + common;
                     ms[l * n + j] += v;
                     if l != j {
                         ms[j * n + l] += v;

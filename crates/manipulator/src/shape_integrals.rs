@@ -64,6 +64,8 @@ struct FastEntries {
     joint_mode: Vec<[f64; 3]>,
     /// The modes' block of M, `0 + (P_kl + ∫ρI θ_k θ_l)`, column-major m × m.
     modal_mass: Vec<f64>,
+    /// `P_kl = ∫ρA ψ_k ψ_l`, row-major m × m (row k contiguous).
+    mode_products: Vec<f64>,
 }
 
 /// The ρA-weighted moments of a link's deflection at (q, u) that the dynamics need:
@@ -146,6 +148,9 @@ impl ShapeIntegrals {
                     let (l, k) = (lk / m, lk % m);
                     0.0 + (self.mode_product(k, l) + self.rotary_product(k, l))
                 })
+                .collect(),
+            mode_products: (0..m * m)
+                .map(|kl| self.mode_product(kl / m, kl % m))
                 .collect(),
         };
     }
@@ -274,31 +279,50 @@ impl ShapeIntegrals {
 
     /// The moments of the deflection with modal coordinates `q` and speeds `u` (m each).
     pub(crate) fn deflection_moments(&self, q: &[f64], u: &[f64]) -> DeflectionMoments {
+        let m = self.n_modes();
+        let (q, u) = (&q[..m], &u[..m]);
         let mut d = DeflectionMoments::default();
-        for k in 0..q.len() {
+        let rows = self.fast.mode_products.chunks_exact(m.max(1));
+        for ((row, [a, b, _]), (qk, uk)) in rows.zip(&self.fast.joint_mode).zip(q.iter().zip(u)) {
+            // (Pq)_k, (Pu)_k
             let (mut pq, mut pu) = (0.0, 0.0);
-            for l in 0..q.len() {
-                let p = self.mode_product(k, l);
-                pq += p * q[l];
-                pu += p * u[l];
+            for (p, (ql, ul)) in row.iter().zip(q.iter().zip(u)) {
+                pq += p * ql;
+                pu += p * ul;
             }
-            let (a, b) = (self.mode_mass(k), self.mode_moment(k));
-            d.w += a * q[k];
-            d.w_dot += a * u[k];
-            d.x_w_dot += b * u[k];
-            d.w_w += q[k] * pq;
-            d.w_w_dot += q[k] * pu;
-            d.w_dot_w_dot += u[k] * pu;
+            d.w += a * qk;
+            d.w_dot += a * uk;
+            d.x_w_dot += b * uk;
+            d.w_w += qk * pq;
+            d.w_w_dot += qk * pu;
+            d.w_dot_w_dot += uk * pu;
         }
         d
     }
 
+    /// `(∫ρA w, ∫ρA w²) = (aᵀq, qᵀPq)`: the moments the mass matrix reads, the same numbers
+    /// as those of [`deflection_moments`](Self::deflection_moments)`(q, q)`.
+    pub(crate) fn deflection_and_square(&self, q: &[f64]) -> (f64, f64) {
+        let m = self.n_modes();
+        let q = &q[..m];
+        let (mut w, mut w_w) = (0.0, 0.0);
+        let rows = self.fast.mode_products.chunks_exact(m.max(1));
+        for ((row, [a, ..]), qk) in rows.zip(&self.fast.joint_mode).zip(q) {
+            let mut pq = 0.0;
+            for (p, ql) in row.iter().zip(q) {
+                pq += p * ql;
+            }
+            w += a * qk;
+            w_w += qk * pq;
+        }
+        (w, w_w)
+    }
+
     /// `(Pq)_k = ∫ρA ψ_k w`.
     pub(crate) fn mode_times_deflection(&self, k: usize, q: &[f64]) -> f64 {
-        q.iter()
-            .enumerate()
-            .map(|(l, ql)| self.mode_product(k, l) * ql)
-            .sum()
+        let m = self.n_modes();
+        let row = &self.fast.mode_products[k * m..(k + 1) * m];
+        row.iter().zip(q).map(|(p, ql)| p * ql).sum()
     }
 }
 
@@ -399,5 +423,76 @@ mod tests {
         let want = nalgebra::dmatrix![5000.0, 30000.0; 30000.0, 180000.0];
         assert!((p.translation() - want).abs().max() < 1e-9);
         assert!(p.rotary().abs() < 1e-300);
+    }
+
+    /// The deflection moments as written before the row-major copy of P (the reference).
+    fn moments_reference(g: &ShapeIntegrals, q: &[f64], u: &[f64]) -> DeflectionMoments {
+        let mut d = DeflectionMoments::default();
+        for k in 0..q.len() {
+            let (mut pq, mut pu) = (0.0, 0.0);
+            for l in 0..q.len() {
+                let p = g.mode_product(k, l);
+                pq += p * q[l];
+                pu += p * u[l];
+            }
+            let (a, b) = (g.mode_mass(k), g.mode_moment(k));
+            d.w += a * q[k];
+            d.w_dot += a * u[k];
+            d.x_w_dot += b * u[k];
+            d.w_w += q[k] * pq;
+            d.w_w_dot += q[k] * pu;
+            d.w_dot_w_dot += u[k] * pu;
+        }
+        d
+    }
+
+    #[test]
+    fn contiguous_moments_give_the_bits_of_the_matrix_entries() {
+        let beam = Link::beam(8.0, 210e9, 7850.0, 0.0264, 5.89e-4).unwrap();
+        let point = crate::PointMass {
+            x: 3.0,
+            mass: 200.0,
+            inertia: 7.0,
+        };
+        let mut state = 0x2545_F491_4F6C_DD1D_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            match state % 11 {
+                0 => 0.0,
+                1 => -0.0,
+                r => (state >> 11) as f64 / (1u64 << 53) as f64 * 1e-2 - 5e-3 + r as f64 * 1e-4,
+            }
+        };
+        for modes in 0..=6 {
+            let sines = beam.clone().with_sine_modes(modes).unwrap();
+            let quad = (1..=modes).fold(beam.clone(), |l, k| {
+                l.with_mode(Arc::new(Anonymous(SineMode::new(k, 8.0))))
+                    .unwrap()
+            });
+            for link in [sines.clone(), quad, sines.with_point_mass(point).unwrap()] {
+                let g = ShapeIntegrals::of(&link, 16).unwrap();
+                for _ in 0..200 {
+                    let q: Vec<f64> = (0..modes).map(|_| next()).collect();
+                    let u: Vec<f64> = (0..modes).map(|_| next()).collect();
+                    let (got, want) = (g.deflection_moments(&q, &u), moments_reference(&g, &q, &u));
+                    let bits = |d: DeflectionMoments| {
+                        [d.w, d.w_dot, d.x_w_dot, d.w_w, d.w_w_dot, d.w_dot_w_dot].map(f64::to_bits)
+                    };
+                    assert_eq!(bits(got), bits(want));
+                    let square = moments_reference(&g, &q, &q);
+                    let (w, w_w) = g.deflection_and_square(&q);
+                    assert_eq!(
+                        [w, w_w].map(f64::to_bits),
+                        [square.w, square.w_w].map(f64::to_bits)
+                    );
+                    for k in 0..q.len() {
+                        let old: f64 = (0..q.len()).map(|l| g.mode_product(k, l) * q[l]).sum();
+                        assert_eq!(g.mode_times_deflection(k, &q).to_bits(), old.to_bits());
+                    }
+                }
+            }
+        }
     }
 }

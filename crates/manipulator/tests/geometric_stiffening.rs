@@ -139,7 +139,11 @@ fn e_mdot_u_and_g_are_derivatives_of_t_m_and_v_g() {
             let shifted =
                 |s: f64| -> Vec<f64> { q.iter().zip(&u).map(|(x, v)| x + s * v).collect() };
             let (qp, qm) = (shifted(H), shifted(-H));
-            (a.kinematics(&qp).mass_matrix() - a.kinematics(&qm).mass_matrix()) / (2.0 * H) * &uv
+            let (mp, mm) = (
+                a.kinematics(&qp).mass_matrix(),
+                a.kinematics(&qm).mass_matrix(),
+            );
+            (mp - mm) / (2.0 * H) * &uv
         });
         assert_change("Ṁu", &col(mdot), &col(fd));
         // G = −∂V_g/∂q

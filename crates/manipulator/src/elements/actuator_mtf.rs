@@ -48,6 +48,8 @@ struct Modulus {
     lengths: AtLastQ<Lengths>,
     hessians: AtLastQ<Vec<DMatrix<f64>>>,
     jd: Vec<Vector2<f64>>,
+    /// The MTF law's running sums (length max(n, n_act)).
+    acc: Vec<f64>,
 }
 
 /// `τ_b = ∂l/∂q` (column c for actuator c) and the lengths l.
@@ -58,14 +60,6 @@ struct Lengths {
 }
 
 impl Modulus {
-    /// τ_b and the lengths at q.
-    fn lengths(&mut self, arm: &PlanarArm, pins: &[(PinPoint, PinPoint)], q: &[f64]) -> &Lengths {
-        let Self {
-            frames, lengths, ..
-        } = self;
-        lengths_at(lengths, frames, arm, pins, q)
-    }
-
     /// τ_b, the lengths and their Hessians `∇²l_c` at q.
     fn with_hessians(
         &mut self,
@@ -78,6 +72,7 @@ impl Modulus {
             lengths,
             hessians,
             jd,
+            ..
         } = self;
         let lengths = lengths_at(lengths, frames, arm, pins, q);
         let (_, hessians) = hessians.get_or_update(q, |q, hessians| {
@@ -140,6 +135,7 @@ impl ActuatorTransformer {
                 ),
                 hessians: AtLastQ::new(n, vec![DMatrix::zeros(n, n); acts.len()]),
                 jd: vec![Vector2::zeros(); n],
+                acc: vec![0.0; n.max(acts.len())],
             }),
             arm,
             pins,
@@ -205,11 +201,17 @@ impl Element for ActuatorTransformer {
     }
     fn eval(&self, stage: usize, io: &mut Io<'_>) {
         let mut ws = self.ws.borrow_mut();
-        let Lengths { tau, l } = ws.lengths(&self.arm, &self.pins, io.input(0));
+        let Modulus {
+            frames,
+            lengths,
+            acc,
+            ..
+        } = &mut *ws;
+        let Lengths { tau, l } = lengths_at(lengths, frames, &self.arm, &self.pins, io.input(0));
         let n = self.pins.len();
         match stage {
-            0 => mtf_law::set_effort(io, tau),
-            1 => mtf_law::set_flow(io, tau),
+            0 => mtf_law::set_effort(io, tau, acc),
+            1 => mtf_law::set_flow(io, tau, acc),
             2 => {
                 for (c, lc) in l.iter().enumerate() {
                     io.set_y(c, 0, *lc);

@@ -39,6 +39,8 @@ pub struct LumpedMassTransformer {
 struct Modulus {
     frames: Frames,
     jt: AtLastQ<DMatrix<f64>>,
+    /// The MTF law's running sums (length max(n, 2m)).
+    acc: Vec<f64>,
 }
 
 impl LumpedMassTransformer {
@@ -67,6 +69,7 @@ impl LumpedMassTransformer {
             ws: RefCell::new(Modulus {
                 frames: arm.frames(),
                 jt: AtLastQ::new(n, DMatrix::zeros(n, 2 * pins.len())),
+                acc: vec![0.0; n.max(2 * pins.len())],
             }),
             arm,
             stations,
@@ -75,15 +78,8 @@ impl LumpedMassTransformer {
     }
 }
 
-impl Modulus {
-    /// `J_cᵀ` (n × 2m, eq. 71) at q: column 2k, 2k+1 the x, y velocity Jacobian of pin k;
-    /// and q.
-    fn jt(&mut self, arm: &PlanarArm, stations: &[Station], q: &[f64]) -> (&[f64], &DMatrix<f64>) {
-        let Self { frames, jt } = self;
-        jt_at(jt, frames, arm, stations, q)
-    }
-}
-
+/// `J_cᵀ` (n × 2m, eq. 71) at q: column 2k, 2k+1 the x, y velocity Jacobian of pin k;
+/// and q.
 fn jt_at<'a>(
     jt: &'a mut AtLastQ<DMatrix<f64>>,
     frames: &mut Frames,
@@ -127,16 +123,17 @@ impl Element for LumpedMassTransformer {
     }
     fn eval(&self, stage: usize, io: &mut Io<'_>) {
         let mut ws = self.ws.borrow_mut();
-        let (_, jt) = ws.jt(&self.arm, &self.stations, io.input(0));
+        let Modulus { frames, jt, acc } = &mut *ws;
+        let (_, jt) = jt_at(jt, frames, &self.arm, &self.stations, io.input(0));
         if stage == 0 {
-            mtf_law::set_effort(io, jt);
+            mtf_law::set_effort(io, jt, acc);
         } else {
-            mtf_law::set_flow(io, jt);
+            mtf_law::set_flow(io, jt, acc);
         }
     }
     fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
         let mut ws = self.ws.borrow_mut();
-        let Modulus { frames, jt } = &mut *ws;
+        let Modulus { frames, jt, .. } = &mut *ws;
         let (q, jt) = jt_at(jt, frames, &self.arm, &self.stations, io.input(0));
         let pose = self.arm.pose_in(q, frames);
         if stage == 0 {
