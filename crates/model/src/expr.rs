@@ -479,21 +479,40 @@ fn reads_inputs(n: &Node) -> bool {
     }
 }
 
+/// The value of `n`. Leaves are read in place rather than through a call, and a function
+/// call's argument buffer lives in [`eval_call`]: the same operations in the same order, in
+/// a smaller recursion (the crane's run: 14.5 → 12.6 M instructions of evaluation).
 fn eval_node(n: &Node, u: &[f64], tables: &Tables) -> f64 {
     match n {
         Node::Num(v) => *v,
         Node::Input(i) => u[*i],
-        Node::Neg(a) => -eval_node(a, u, tables),
-        Node::Bin(op, a, b) => op.apply(eval_node(a, u, tables), eval_node(b, u, tables)),
-        Node::Call(f, args) => {
-            let mut buf = [0.0; MAX_ARGS];
-            let n = args.len().min(MAX_ARGS);
-            for (k, a) in args.iter().take(n).enumerate() {
-                buf[k] = eval_node(a, u, tables);
-            }
-            f.apply(&buf[..n], tables, None)
+        Node::Neg(a) => -eval_operand(a, u, tables),
+        Node::Bin(op, a, b) => {
+            let a = eval_operand(a, u, tables);
+            op.apply(a, eval_operand(b, u, tables))
         }
+        Node::Call(f, args) => eval_call(*f, args, u, tables),
     }
+}
+
+/// An operand: a leaf at once, any other node by [`eval_node`].
+#[inline(always)]
+fn eval_operand(n: &Node, u: &[f64], tables: &Tables) -> f64 {
+    match n {
+        Node::Num(v) => *v,
+        Node::Input(i) => u[*i],
+        _ => eval_node(n, u, tables),
+    }
+}
+
+#[inline(never)]
+fn eval_call(f: Func, args: &[Node], u: &[f64], tables: &Tables) -> f64 {
+    let mut buf = [0.0; MAX_ARGS];
+    let n = args.len().min(MAX_ARGS);
+    for (k, a) in args.iter().take(n).enumerate() {
+        buf[k] = eval_operand(a, u, tables);
+    }
+    f.apply(&buf[..n], tables, None)
 }
 
 /// Value of `n` and its gradient into `g` (zeroed here).

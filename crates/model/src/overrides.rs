@@ -82,7 +82,14 @@ pub(crate) fn check(file: &str, doc: &DocumentMut, o: &str) -> Result<(), ModelE
     let mut root = toml_edit::Table::new();
     if let Some(first) = path.first() {
         // `events[0]` reads the section `events`; a key written `name[k]` is itself a key
-        for k in [first.key.clone(), first.literal()] {
+        let (key, literal) = (first.key.clone(), first.literal());
+        // (the two are one key unless it is written `name[k]`: the section is cloned once)
+        let keys = if literal == key {
+            vec![key]
+        } else {
+            vec![key, literal]
+        };
+        for k in keys {
             if let Some(item) = doc.as_table().get(&k) {
                 root.insert(&k, item.clone());
             }

@@ -120,8 +120,9 @@ impl Stepper for RadauStepper<'_> {
     fn t_h(&self) -> (f64, f64) {
         (self.radau.t(), self.radau.h())
     }
-    fn y(&self) -> Vec<f64> {
-        self.radau.y().to_vec()
+    fn y_into(&self, out: &mut Vec<f64>) {
+        out.clear();
+        out.extend_from_slice(self.radau.y());
     }
     fn interpolate(&self, t: f64) -> Result<Vec<f64>, String> {
         let mut y = vec![0.0; self.radau.y().len()];

@@ -172,14 +172,18 @@ impl Recorder<'_> {
     pub(super) fn pending(&self) -> Option<f64> {
         self.grid.at(self.p.next)
     }
-    /// Every accepted step: watched minima, the sink's per-step values, and whether the run
-    /// must stop (a refused row, or the interruption flag).
+    /// Every accepted step: watched minima, and whether the run must stop (a refused row, or
+    /// the interruption flag). The step's outputs follow its rows ([`Self::step_done`]).
     pub(super) fn accepted(&mut self, t: f64, x: &[f64]) -> Result<(), SimulationError> {
         watch(&mut self.p.watchers, t, x);
+        self.should_stop(t)
+    }
+    /// Every accepted step, after its rows: the sink's per-step values, if it wants them
+    /// (those of a step onto an event are handed on after the switch).
+    pub(super) fn step_done(&mut self, t: f64, x: &[f64]) {
         if self.wants_steps && !self.event_at.is_some_and(|te| same_time(te, t)) {
             self.step_values(t, x);
         }
-        self.should_stop(t)
     }
     /// Hand the outputs at (t, x) to the sink as a step.
     pub(super) fn step_values(&mut self, t: f64, x: &[f64]) {

@@ -237,8 +237,12 @@ fn record_without_states(rec: &mut Recorder<'_>, t_stop: f64) -> Result<Vec<f64>
         if tg > t_stop || same_time(tg, t_stop) {
             break;
         }
-        rec.accepted(tg, &[]).map_err(|e| (tg, Vec::new(), e))?;
-        rec.record(tg, &[]);
+        let go_on = rec.accepted(tg, &[]);
+        if go_on.is_ok() {
+            rec.record(tg, &[]);
+        }
+        rec.step_done(tg, &[]);
+        go_on.map_err(|e| (tg, Vec::new(), e))?;
     }
     Ok(Vec::new())
 }

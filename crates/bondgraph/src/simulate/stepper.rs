@@ -39,8 +39,8 @@ pub(super) trait Stepper {
     fn step(&mut self) -> Result<StepEnd, String>;
     /// Current time and step size.
     fn t_h(&self) -> (f64, f64);
-    /// Current state.
-    fn y(&self) -> Vec<f64>;
+    /// Current state, into `out` (resized to it).
+    fn y_into(&self, out: &mut Vec<f64>);
     /// The state at `t` inside the last step.
     fn interpolate(&self, t: f64) -> Result<Vec<f64>, String>;
     /// [`Stepper::interpolate`] into `out` (the energy audit's nodes; Radau without
@@ -82,8 +82,9 @@ where
         let st = self.0.state();
         (st.t, st.h)
     }
-    fn y(&self) -> Vec<f64> {
-        self.0.state().y.batch_as_slice(0).to_vec()
+    fn y_into(&self, out: &mut Vec<f64>) {
+        out.clear();
+        out.extend_from_slice(self.0.state().y.batch_as_slice(0));
     }
     fn interpolate(&self, t: f64) -> Result<Vec<f64>, String> {
         self.0
@@ -123,17 +124,13 @@ pub(super) fn drive(
         stats.newton_failures += w.newton_failures;
         stats.lu_factorisations += w.lu;
     };
-    let solver_error = |t: f64, message: String, culprit: String| SimulationError::Solver {
-        t,
-        message,
-        culprit,
-        hint: None,
-    };
     let mut t_prev = s.t_h().0;
+    // The state after each step and at each row, in buffers kept over the segment.
+    let (mut x, mut xi) = (Vec::new(), Vec::new());
     loop {
         let step = s.step();
         let (t, h) = s.t_h();
-        let x = s.y();
+        s.y_into(&mut x);
         let reason = match step {
             Err(e) => {
                 finish(s, stats);
@@ -166,82 +163,125 @@ pub(super) fn drive(
             ));
         }
         // The run observes an interruption (`Settings::interrupt`) and a refused row here, in
-        // one place, after every accepted step; the per-step outputs (checks) are handed on too.
-        if let Err(e) = rec.accepted(t, &x) {
-            finish(s, stats);
-            return Err((t, x, e));
-        }
-        if let Some(i) = x.iter().position(|v| !v.is_finite()) {
-            finish(s, stats);
-            let info = &eqs.states()[i];
-            let err = SimulationError::NonFinite {
-                t,
-                state: info.name.clone(),
-                element: eqs.graph().node(info.element).name.clone(),
-                value: x[i],
-                culprit: culprit(eqs, bad),
-            };
-            return Err((t, x, err));
-        }
-        // A limit reached inside the step: rows up to the crossing, then stop there.
-        let root = match reason {
-            StepEnd::Root(tr, idx) => Some((tr, idx)),
-            _ => None,
+        // one place, after every accepted step.
+        let end = match rec.accepted(t, &x) {
+            Err(e) => Some(Err((t, x.clone(), e))),
+            Ok(()) => after_step(
+                s,
+                rec,
+                (t_prev, t),
+                &x,
+                &mut xi,
+                reason,
+                t_stop,
+                limits,
+                bad,
+            ),
         };
-        let t_rows = root.map_or(t, |(tr, _)| tr);
-        // The energy audit: the power at the step's quadrature nodes (`crate::energy`).
-        if let Some(audit) = rec.audit.as_deref_mut() {
-            let audited = if root.is_some() {
-                let mut xr = x.clone();
-                s.interpolate_into(t_rows, &mut xr).and_then(|()| {
-                    audit.step(eqs, t_prev, t_rows, &xr, |tq, y| s.interpolate_into(tq, y))
-                })
-            } else {
-                audit.step(eqs, t_prev, t, &x, |tq, y| s.interpolate_into(tq, y))
-            };
-            if let Err(e) = audited {
-                finish(s, stats);
-                let message = format!("energy audit at t = {t}: {e}");
-                return Err((t, x, solver_error(t, message, String::new())));
-            }
+        // The outputs at the step itself (checks), after the rows up to it: in time order,
+        // and the elements' values cached at x serve the next step's f(t, x).
+        rec.step_done(t, &x);
+        if let Some(end) = end {
+            finish(s, stats);
+            return end;
         }
         t_prev = t;
-        while let Some(tg) = rec.pending() {
-            if tg > t_rows
-                || same_time(tg, t_stop)
-                || tg > t_stop
-                || (root.is_some() && same_time(tg, t_rows))
-            {
-                break;
-            }
-            if same_time(tg, t) {
-                rec.record(tg, &x);
-            } else {
-                match s.interpolate(tg) {
-                    Ok(y) => rec.record(tg, &y),
-                    Err(e) => {
-                        finish(s, stats);
-                        let message = format!("interpolation at t = {tg}: {e}");
-                        return Err((t, x, solver_error(t, message, String::new())));
-                    }
-                }
-            }
-        }
-        if let Some((tr, idx)) = root {
-            finish(s, stats);
-            let xr = s.interpolate(tr).unwrap_or(x);
-            let err = limits.get(idx).map_or_else(
-                || {
-                    let message = format!("root {idx} found, but no limit has that index");
-                    solver_error(tr, message, String::new())
-                },
-                |b| b.error(tr),
-            );
-            return Err((tr, xr, err));
-        }
-        if reason == StepEnd::StopReached {
-            finish(s, stats);
-            return Ok(x);
+    }
+}
+
+fn solver_error(t: f64, message: String, culprit: String) -> SimulationError {
+    SimulationError::Solver {
+        t,
+        message,
+        culprit,
+        hint: None,
+    }
+}
+
+/// After an accepted step [t0, t] to state `x`: the finite-state check, the energy audit, the
+/// rows up to t (or up to a limit's crossing inside the step) and the segment's end. `None`:
+/// go on stepping.
+#[allow(clippy::too_many_arguments)]
+fn after_step(
+    s: &dyn Stepper,
+    rec: &mut Recorder<'_>,
+    (t0, t): (f64, f64),
+    x: &[f64],
+    xi: &mut Vec<f64>,
+    reason: StepEnd,
+    t_stop: f64,
+    limits: &[Bound],
+    bad: &RefCell<Option<(f64, Vec<f64>)>>,
+) -> Option<Result<Vec<f64>, SegmentError>> {
+    let eqs = rec.eqs;
+    if let Some(i) = x.iter().position(|v| !v.is_finite()) {
+        let info = &eqs.states()[i];
+        let err = SimulationError::NonFinite {
+            t,
+            state: info.name.clone(),
+            element: eqs.graph().node(info.element).name.clone(),
+            value: x[i],
+            culprit: culprit(eqs, bad),
+        };
+        return Some(Err((t, x.to_vec(), err)));
+    }
+    // A limit reached inside the step: rows up to the crossing, then stop there.
+    let root = match reason {
+        StepEnd::Root(tr, idx) => Some((tr, idx)),
+        _ => None,
+    };
+    let t_rows = root.map_or(t, |(tr, _)| tr);
+    // The energy audit: the power at the step's quadrature nodes (`crate::energy`).
+    if let Some(audit) = rec.audit.as_deref_mut() {
+        let audited = if root.is_some() {
+            let mut xr = x.to_vec();
+            s.interpolate_into(t_rows, &mut xr)
+                .and_then(|()| audit.step(eqs, t0, t_rows, &xr, |tq, y| s.interpolate_into(tq, y)))
+        } else {
+            audit.step(eqs, t0, t, x, |tq, y| s.interpolate_into(tq, y))
+        };
+        if let Err(e) = audited {
+            let message = format!("energy audit at t = {t}: {e}");
+            return Some(Err((
+                t,
+                x.to_vec(),
+                solver_error(t, message, String::new()),
+            )));
         }
     }
+    while let Some(tg) = rec.pending() {
+        if tg > t_rows
+            || same_time(tg, t_stop)
+            || tg > t_stop
+            || (root.is_some() && same_time(tg, t_rows))
+        {
+            break;
+        }
+        if same_time(tg, t) {
+            rec.record(tg, x);
+        } else {
+            xi.resize(x.len(), 0.0);
+            if let Err(e) = s.interpolate_into(tg, xi) {
+                let message = format!("interpolation at t = {tg}: {e}");
+                return Some(Err((
+                    t,
+                    x.to_vec(),
+                    solver_error(t, message, String::new()),
+                )));
+            }
+            rec.record(tg, xi);
+        }
+    }
+    if let Some((tr, idx)) = root {
+        let xr = s.interpolate(tr).unwrap_or_else(|_| x.to_vec());
+        let err = limits.get(idx).map_or_else(
+            || {
+                let message = format!("root {idx} found, but no limit has that index");
+                solver_error(tr, message, String::new())
+            },
+            |b| b.error(tr),
+        );
+        return Some(Err((tr, xr, err)));
+    }
+    (reason == StepEnd::StopReached).then(|| Ok(x.to_vec()))
 }

@@ -17,7 +17,9 @@ pub fn push_f64(out: &mut Vec<u8>, v: f64) {
     }
     let mut buf = zmij::Buffer::new();
     let s = buf.format_finite(v).as_bytes();
-    if !s.contains(&b'e') {
+    // zmij's exponent is `e±d`, `e±dd` or `e±ddd`: its `e` is among the last five bytes (the
+    // whole number searched was 6.6 M instructions of memchr a crane CSV)
+    if !s[s.len().saturating_sub(5)..].contains(&b'e') {
         // plain decimal notation, and not an integer (those are short exact values): the
         // same text as `{}`
         out.extend_from_slice(s);
