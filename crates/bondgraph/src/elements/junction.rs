@@ -12,10 +12,15 @@ use crate::kind::KindDecl;
 use crate::local_jacobian::LocalJacobian;
 
 fn dominant(io: &Io<'_>, c: PortCausality) -> usize {
-    (0..io.n_ports())
-        .find(|&p| io.causality(p) == c)
+    io.layout
+        .ports
+        .iter()
+        .position(|p| p.causality == c)
         .unwrap_or(0)
 }
+
+/// Widest bond whose junction values are gathered on the stack (wider ones: in place).
+const MAX_LOCAL: usize = 16;
 
 fn two_stages(
     causality: &[PortCausality],
@@ -50,6 +55,20 @@ fn share(values: &mut [f64], layout: &Layout, d: usize) {
         }
         return;
     }
+    if dim <= MAX_LOCAL {
+        // multibonds: one read of the dominant values, plain stores per port
+        let mut buf = [0.0; MAX_LOCAL];
+        let v = &mut buf[..dim];
+        v.copy_from_slice(&values[from..from + dim]);
+        for (p, port) in layout.ports.iter().enumerate() {
+            if p != d {
+                for (to, x) in values[port.offset..port.offset + dim].iter_mut().zip(&*v) {
+                    *to = *x;
+                }
+            }
+        }
+        return;
+    }
     for (p, port) in layout.ports.iter().enumerate() {
         if p != d {
             values.copy_within(from..from + dim, port.offset);
@@ -74,6 +93,21 @@ fn balance(values: &mut [f64], layout: &Layout, d: usize) {
             }
         }
         values[to] = sum;
+        return;
+    }
+    if dim <= MAX_LOCAL {
+        // multibonds: the same sums (0 + s₁v₁ + s₂v₂ + …, ports in order) in a stack buffer
+        let mut buf = [0.0; MAX_LOCAL];
+        let sum = &mut buf[..dim];
+        for (p, port) in layout.ports.iter().enumerate() {
+            if p != d {
+                let s = -sd * port.sign;
+                for (a, v) in sum.iter_mut().zip(&values[port.offset..port.offset + dim]) {
+                    *a += s * v;
+                }
+            }
+        }
+        values[to..to + dim].copy_from_slice(sum);
         return;
     }
     values[to..to + dim].fill(0.0);

@@ -21,19 +21,61 @@ use crate::local_jacobian::LocalJacobian;
 /// The modulus law: fill `t` (n₁×n₂) from time and the element's inputs.
 pub type ModulusLaw = Box<dyn Fn(&Io<'_>, &mut DMatrix<f64>)>;
 
+/// Widest port whose values [`apply_effort`] and [`apply_flow`] gather on the stack.
+const MAX_LOCAL: usize = 16;
+
 /// `e₁ = T·e₂` on ports 0 and 1 of `io` (for matrix MTFs of other crates too).
 pub fn apply_effort(io: &mut Io<'_>, t: &DMatrix<f64>) {
-    for i in 0..t.nrows() {
-        let e: f64 = (0..t.ncols()).map(|j| t[(i, j)] * io.e(1, j)).sum();
-        io.set_e(0, i, e);
+    let (n1, n2) = t.shape();
+    if n2 > MAX_LOCAL {
+        for i in 0..n1 {
+            let e: f64 = (0..n2).map(|j| t[(i, j)] * io.e(1, j)).sum();
+            io.set_e(0, i, e);
+        }
+        return;
+    }
+    // e₂ on the stack, then row i of T (stride n₁ in column-major storage) times it:
+    // the same products summed in the same order as Σ_j T_ij e₂_j
+    let (o1, o2) = (io.layout.ports[0].offset, io.layout.ports[1].offset);
+    let mut buf = [0.0; MAX_LOCAL];
+    let e2 = &mut buf[..n2];
+    e2.copy_from_slice(&io.effort[o2..o2 + n2]);
+    let data = t.as_slice();
+    for (i, e1) in io.effort[o1..o1 + n1].iter_mut().enumerate() {
+        *e1 = data[i..]
+            .iter()
+            .step_by(n1)
+            .zip(&*e2)
+            .map(|(tij, e)| tij * e)
+            .sum();
     }
 }
 
 /// `f_in₂ = −Tᵀ·f_in₁` on ports 0 and 1 of `io`.
 pub fn apply_flow(io: &mut Io<'_>, t: &DMatrix<f64>) {
-    for j in 0..t.ncols() {
-        let f: f64 = (0..t.nrows()).map(|i| t[(i, j)] * io.f_in(0, i)).sum();
-        io.set_f_in(1, j, -f);
+    let (n1, n2) = t.shape();
+    if n1 > MAX_LOCAL || n1 == 0 {
+        for j in 0..n2 {
+            let f: f64 = (0..n1).map(|i| t[(i, j)] * io.f_in(0, i)).sum();
+            io.set_f_in(1, j, -f);
+        }
+        return;
+    }
+    // f_in₁ on the stack, then column j of T (contiguous) times it: Σ_i T_ij f_in₁_i
+    let (p1, p2) = (&io.layout.ports[0], &io.layout.ports[1]);
+    let mut buf = [0.0; MAX_LOCAL];
+    let f1 = &mut buf[..n1];
+    for (b, f) in f1.iter_mut().zip(&io.flow[p1.offset..p1.offset + n1]) {
+        *b = p1.sign * f;
+    }
+    let s2 = p2.sign;
+    for (col, f2) in t
+        .as_slice()
+        .chunks_exact(n1)
+        .zip(&mut io.flow[p2.offset..p2.offset + n2])
+    {
+        let f: f64 = col.iter().zip(&*f1).map(|(tij, f)| tij * f).sum();
+        *f2 = s2 * -f;
     }
 }
 
