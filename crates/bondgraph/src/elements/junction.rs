@@ -19,7 +19,7 @@ fn dominant(io: &Io<'_>, c: PortCausality) -> usize {
         .unwrap_or(0)
 }
 
-/// Widest bond whose junction values are gathered on the stack (wider ones: in place).
+/// Widest bond whose junction sums are formed on the stack (wider ones: in place).
 const MAX_LOCAL: usize = 16;
 
 fn two_stages(
@@ -51,20 +51,6 @@ fn share(values: &mut [f64], layout: &Layout, d: usize) {
         for (p, port) in layout.ports.iter().enumerate() {
             if p != d {
                 values[port.offset] = v;
-            }
-        }
-        return;
-    }
-    if dim <= MAX_LOCAL {
-        // multibonds: one read of the dominant values, plain stores per port
-        let mut buf = [0.0; MAX_LOCAL];
-        let v = &mut buf[..dim];
-        v.copy_from_slice(&values[from..from + dim]);
-        for (p, port) in layout.ports.iter().enumerate() {
-            if p != d {
-                for (to, x) in values[port.offset..port.offset + dim].iter_mut().zip(&*v) {
-                    *to = *x;
-                }
             }
         }
         return;

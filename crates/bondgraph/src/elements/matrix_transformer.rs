@@ -27,27 +27,31 @@ const MAX_LOCAL: usize = 16;
 /// `e₁ = T·e₂` on ports 0 and 1 of `io` (for matrix MTFs of other crates too).
 pub fn apply_effort(io: &mut Io<'_>, t: &DMatrix<f64>) {
     let (n1, n2) = t.shape();
-    if n2 > MAX_LOCAL {
+    if n2 > MAX_LOCAL || n2 == 0 || n1 == 0 {
         for i in 0..n1 {
             let e: f64 = (0..n2).map(|j| t[(i, j)] * io.e(1, j)).sum();
             io.set_e(0, i, e);
         }
         return;
     }
-    // e₂ on the stack, then row i of T (stride n₁ in column-major storage) times it:
-    // the same products summed in the same order as Σ_j T_ij e₂_j
+    // e₂ on the stack, then e₁ += T_:j·e₂_j column by column (T is column-major): each
+    // e₁_i is the sum Σ_j T_ij e₂_j in the same order as `Iterator::sum`, which starts at
+    // −0 (−0 + a = a exactly, so the first term is stored)
     let (o1, o2) = (io.layout.ports[0].offset, io.layout.ports[1].offset);
     let mut buf = [0.0; MAX_LOCAL];
     let e2 = &mut buf[..n2];
     e2.copy_from_slice(&io.effort[o2..o2 + n2]);
-    let data = t.as_slice();
-    for (i, e1) in io.effort[o1..o1 + n1].iter_mut().enumerate() {
-        *e1 = data[i..]
-            .iter()
-            .step_by(n1)
-            .zip(&*e2)
-            .map(|(tij, e)| tij * e)
-            .sum();
+    let e1 = &mut io.effort[o1..o1 + n1];
+    let mut cols = t.as_slice().chunks_exact(n1).zip(&*e2);
+    if let Some((col, &e)) = cols.next() {
+        for (y, tij) in e1.iter_mut().zip(col) {
+            *y = tij * e;
+        }
+    }
+    for (col, &e) in cols {
+        for (y, tij) in e1.iter_mut().zip(col) {
+            *y += tij * e;
+        }
     }
 }
 
