@@ -164,7 +164,16 @@ impl<'a> Io<'a> {
     #[inline]
     #[must_use]
     pub fn u(&self, i: usize) -> f64 {
-        self.input(i)[0]
+        // `input(i)[0]` without forming the slice
+        let (src, dim) = self.layout.inputs[i];
+        assert!(dim > 0, "signal input {i} is empty");
+        match src {
+            Source::Time => self.t,
+            Source::State(o) => self.x[o],
+            Source::Signal(o) => self.signals[o],
+            Source::Effort(o) => self.effort[o],
+            Source::Flow(o) => self.flow[o],
+        }
     }
     /// Set signal output `i` (component `k`).
     #[inline]

@@ -19,8 +19,30 @@ fn dominant(io: &Io<'_>, c: PortCausality) -> usize {
         .unwrap_or(0)
 }
 
-/// Widest bond whose junction sums are formed on the stack (wider ones: in place).
-const MAX_LOCAL: usize = 16;
+/// Call `$f::<N>(args)` if `dim` is N = 2..=16 (the multibonds of arms: generalized
+/// coordinates, pin velocities) and say whether it did; wider bonds take the general path.
+macro_rules! fixed_width {
+    ($dim:expr, $f:ident, $($arg:expr),*) => {
+        match $dim {
+            2 => { $f::<2>($($arg),*); true }
+            3 => { $f::<3>($($arg),*); true }
+            4 => { $f::<4>($($arg),*); true }
+            5 => { $f::<5>($($arg),*); true }
+            6 => { $f::<6>($($arg),*); true }
+            7 => { $f::<7>($($arg),*); true }
+            8 => { $f::<8>($($arg),*); true }
+            9 => { $f::<9>($($arg),*); true }
+            10 => { $f::<10>($($arg),*); true }
+            11 => { $f::<11>($($arg),*); true }
+            12 => { $f::<12>($($arg),*); true }
+            13 => { $f::<13>($($arg),*); true }
+            14 => { $f::<14>($($arg),*); true }
+            15 => { $f::<15>($($arg),*); true }
+            16 => { $f::<16>($($arg),*); true }
+            _ => false,
+        }
+    };
+}
 
 fn two_stages(
     causality: &[PortCausality],
@@ -55,11 +77,44 @@ fn share(values: &mut [f64], layout: &Layout, d: usize) {
         }
         return;
     }
+    if fixed_width!(dim, share_n, values, layout, d) {
+        return;
+    }
     for (p, port) in layout.ports.iter().enumerate() {
         if p != d {
             values.copy_within(from..from + dim, port.offset);
         }
     }
+}
+
+/// [`share`] for bonds of dimension `N`: fixed-size copies (no memmove call per port).
+fn share_n<const N: usize>(values: &mut [f64], layout: &Layout, d: usize) {
+    let from = layout.ports[d].offset;
+    let mut v = [0.0; N];
+    v.copy_from_slice(&values[from..from + N]);
+    for (p, port) in layout.ports.iter().enumerate() {
+        if p != d {
+            values[port.offset..port.offset + N].copy_from_slice(&v);
+        }
+    }
+}
+
+/// [`balance`] for bonds of dimension `N`: the sums 0 + s₁v₁ + s₂v₂ + … (ports in order,
+/// as in place) formed in a fixed-size array.
+fn balance_n<const N: usize>(values: &mut [f64], layout: &Layout, d: usize) {
+    let (to, sd) = (layout.ports[d].offset, layout.ports[d].sign);
+    let mut sum = [0.0; N];
+    for (p, port) in layout.ports.iter().enumerate() {
+        if p != d {
+            let s = -sd * port.sign;
+            let mut v = [0.0; N];
+            v.copy_from_slice(&values[port.offset..port.offset + N]);
+            for (a, x) in sum.iter_mut().zip(v) {
+                *a += s * x;
+            }
+        }
+    }
+    values[to..to + N].copy_from_slice(&sum);
 }
 
 /// Set port `d`'s values so that Σ_p s_p v_p = 0 (the flows of a 0-, the efforts of a
@@ -81,19 +136,7 @@ fn balance(values: &mut [f64], layout: &Layout, d: usize) {
         values[to] = sum;
         return;
     }
-    if dim <= MAX_LOCAL {
-        // multibonds: the same sums (0 + s₁v₁ + s₂v₂ + …, ports in order) in a stack buffer
-        let mut buf = [0.0; MAX_LOCAL];
-        let sum = &mut buf[..dim];
-        for (p, port) in layout.ports.iter().enumerate() {
-            if p != d {
-                let s = -sd * port.sign;
-                for (a, v) in sum.iter_mut().zip(&values[port.offset..port.offset + dim]) {
-                    *a += s * v;
-                }
-            }
-        }
-        values[to..to + dim].copy_from_slice(sum);
+    if fixed_width!(dim, balance_n, values, layout, d) {
         return;
     }
     values[to..to + dim].fill(0.0);
