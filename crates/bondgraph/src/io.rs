@@ -166,7 +166,7 @@ impl<'a> Io<'a> {
     pub fn u(&self, i: usize) -> f64 {
         // `input(i)[0]` without forming the slice
         let (src, dim) = self.layout.inputs[i];
-        assert!(dim > 0, "signal input {i} is empty");
+        assert!(dim > 0 || src == Source::Time, "signal input {i} is empty");
         match src {
             Source::Time => self.t,
             Source::State(o) => self.x[o],

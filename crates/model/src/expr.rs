@@ -483,16 +483,27 @@ fn eval_node(n: &Node, u: &[f64], tables: &Tables) -> f64 {
     match n {
         Node::Num(v) => *v,
         Node::Input(i) => u[*i],
-        Node::Neg(a) => -eval_node(a, u, tables),
-        Node::Bin(op, a, b) => op.apply(eval_node(a, u, tables), eval_node(b, u, tables)),
+        Node::Neg(a) => -operand(a, u, tables),
+        Node::Bin(op, a, b) => op.apply(operand(a, u, tables), operand(b, u, tables)),
         Node::Call(f, args) => {
             let mut buf = [0.0; MAX_ARGS];
             let n = args.len().min(MAX_ARGS);
             for (k, a) in args.iter().take(n).enumerate() {
-                buf[k] = eval_node(a, u, tables);
+                buf[k] = operand(a, u, tables);
             }
             f.apply(&buf[..n], tables, None)
         }
+    }
+}
+
+/// An operand's value: leaves (numbers, inputs; most operands) read here, without a
+/// recursive call.
+#[inline(always)]
+fn operand(n: &Node, u: &[f64], tables: &Tables) -> f64 {
+    match n {
+        Node::Num(v) => *v,
+        Node::Input(i) => u[*i],
+        _ => eval_node(n, u, tables),
     }
 }
 
