@@ -211,6 +211,28 @@ pub const KIND: KindDecl = KindDecl::element(
 mod tests {
     use super::*;
 
+    #[test]
+    fn line_flow_is_bit_identical_to_the_pair_formula() {
+        // the pair as computed before the per-line split (both branches, p_tr = 0 and > 0)
+        for p_tr in [0.0, 2e5] {
+            let v = Valve::new(3e-7, 0.0, 2.1e7, 1e5, p_tr).unwrap();
+            for x_v in [-1.4, -0.63, -1e-9, 0.0, 1e-9, 0.37, 1.0, 2.0] {
+                for (p_a, p_b) in [(5e6, 1.2e7), (2.3e7, 4e4), (1e5, 1e5), (-3e5, 2.1e7)] {
+                    let x = f64::clamp(x_v, -1.0, 1.0);
+                    let r = |dp: f64| v.alpha * x * reg_root(dp, v.p_tr);
+                    let pair = if x >= 0.0 {
+                        (r(v.p_s - p_a), -r(p_b - v.p_t))
+                    } else {
+                        (r(p_a - v.p_t), -r(v.p_s - p_b))
+                    };
+                    let (q_a, q_b) = (v.line_flow(0, x_v, p_a), v.line_flow(1, x_v, p_b));
+                    assert_eq!(q_a.to_bits(), pair.0.to_bits(), "x_v {x_v}, P_A {p_a}");
+                    assert_eq!(q_b.to_bits(), pair.1.to_bits(), "x_v {x_v}, P_B {p_b}");
+                }
+            }
+        }
+    }
+
     /// Eqs. 29–30 written out as printed, with P_r the tank pressure.
     fn paper(alpha: f64, x: f64, p_s: f64, p_t: f64, pp: f64, pr: f64) -> (f64, f64) {
         let sq = |d: f64| d.signum() * d.abs().sqrt();

@@ -260,6 +260,71 @@ pub const ONE: KindDecl = KindDecl::element(
 mod tests {
     use super::*;
     use crate::check_partials;
+    use crate::element::PortLayout;
+
+    /// The in-place `share` and `balance` before the fixed-width paths (the reference).
+    fn share_ref(values: &mut [f64], layout: &Layout, d: usize) {
+        let (from, dim) = (layout.ports[d].offset, layout.ports[d].dim);
+        for (p, port) in layout.ports.iter().enumerate() {
+            if p != d {
+                values.copy_within(from..from + dim, port.offset);
+            }
+        }
+    }
+    fn balance_ref(values: &mut [f64], layout: &Layout, d: usize) {
+        let (to, dim, sd) = (
+            layout.ports[d].offset,
+            layout.ports[d].dim,
+            layout.ports[d].sign,
+        );
+        values[to..to + dim].fill(0.0);
+        for (p, port) in layout.ports.iter().enumerate() {
+            if p != d {
+                let s = -sd * port.sign;
+                for k in 0..dim {
+                    values[to + k] += s * values[port.offset + k];
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn share_and_balance_are_bit_identical_to_the_in_place_loops() {
+        // widths 1 (scalar path), 2..=16 (fixed-size arrays) and 17, 20 (general path);
+        // 1 to 6 ports, every port dominant in turn, values of mixed signs and magnitudes
+        let signs = [1.0, -1.0, -1.0, 1.0, -1.0, 1.0];
+        for dim in (1..=17).chain([20]) {
+            for n in 1..=6 {
+                let layout = Layout {
+                    ports: (0..n)
+                        .map(|p| PortLayout {
+                            offset: 3 + p * dim,
+                            dim,
+                            sign: signs[p],
+                            causality: PortCausality::EffortOut,
+                        })
+                        .collect(),
+                    ..Layout::default()
+                };
+                let len = 3 + n * dim + 2;
+                let start: Vec<f64> = (0..len)
+                    .map(|k| ((k * 7919 % 113) as f64 - 56.3) * 10f64.powi((k % 9) as i32 - 4))
+                    .collect();
+                for d in 0..n {
+                    type Routine = fn(&mut [f64], &Layout, usize);
+                    let pairs: [(Routine, Routine); 2] =
+                        [(share, share_ref), (balance, balance_ref)];
+                    for (fast, slow) in pairs {
+                        let (mut a, mut b) = (start.clone(), start.clone());
+                        fast(&mut a, &layout, d);
+                        slow(&mut b, &layout, d);
+                        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                        assert_eq!(bits(&a), bits(&b), "dim {dim}, {n} ports, dominant {d}");
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn partials_match_central_differences() {

@@ -272,6 +272,76 @@ fn build(p: &dyn Params) -> Result<Box<dyn Element>, BuildError> {
 mod tests {
     use super::*;
     use crate::check_partials;
+    use crate::element::{Layout, PortLayout};
+
+    #[test]
+    fn apply_effort_and_flow_are_bit_identical_to_the_index_loops() {
+        // the loops before the stack copies (through Io's accessors) are the reference;
+        // shapes on both sides of the stack buffer's width (16)
+        for (n1, n2) in [
+            (1, 1),
+            (9, 2),
+            (9, 6),
+            (2, 9),
+            (16, 16),
+            (17, 3),
+            (3, 17),
+            (20, 20),
+        ] {
+            let t = DMatrix::from_fn(n1, n2, |i, j| {
+                ((i * 31 + j * 17) % 23) as f64 * 0.37 - 4.1 + 1e-3 * (i as f64 - j as f64)
+            });
+            let layout = Layout {
+                ports: vec![
+                    PortLayout {
+                        offset: 1,
+                        dim: n1,
+                        sign: -1.0,
+                        causality: PortCausality::EffortOut,
+                    },
+                    PortLayout {
+                        offset: 2 + n1,
+                        dim: n2,
+                        sign: 1.0,
+                        causality: PortCausality::FlowOut,
+                    },
+                ],
+                ..Layout::default()
+            };
+            let len = 3 + n1 + n2;
+            let fill = |k: usize, s: f64| (k as f64 * s).sin() * 10f64.powi((k % 7) as i32 - 3);
+            let (e0, f0): (Vec<f64>, Vec<f64>) = (
+                (0..len).map(|k| fill(k, 1.3)).collect(),
+                (0..len).map(|k| fill(k, 0.7)).collect(),
+            );
+            let run = |fast: bool| {
+                let (mut e, mut f, mut sig) = (e0.clone(), f0.clone(), Vec::new());
+                let mut io = Io {
+                    t: 0.0,
+                    x: &[],
+                    effort: &mut e,
+                    flow: &mut f,
+                    signals: &mut sig,
+                    layout: &layout,
+                };
+                if fast {
+                    apply_effort(&mut io, &t);
+                    apply_flow(&mut io, &t);
+                } else {
+                    for i in 0..n1 {
+                        let v: f64 = (0..n2).map(|j| t[(i, j)] * io.e(1, j)).sum();
+                        io.set_e(0, i, v);
+                    }
+                    for j in 0..n2 {
+                        let v: f64 = (0..n1).map(|i| t[(i, j)] * io.f_in(0, i)).sum();
+                        io.set_f_in(1, j, -v);
+                    }
+                }
+                e.iter().chain(&f).map(|v| v.to_bits()).collect::<Vec<_>>()
+            };
+            assert_eq!(run(true), run(false), "T {n1}×{n2}");
+        }
+    }
 
     #[test]
     fn partials_match_central_differences() {
