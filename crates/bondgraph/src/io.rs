@@ -161,12 +161,12 @@ impl<'a> Io<'a> {
         }
     }
     /// First component of signal input `i`.
-    #[inline]
+    #[inline(always)]
     #[must_use]
     pub fn u(&self, i: usize) -> f64 {
         // `input(i)[0]` without forming the slice
         let (src, dim) = self.layout.inputs[i];
-        assert!(dim > 0 || src == Source::Time, "signal input {i} is empty");
+        assert!(dim > 0 || src == Source::Time, "empty signal input");
         match src {
             Source::Time => self.t,
             Source::State(o) => self.x[o],
