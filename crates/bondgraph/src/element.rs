@@ -416,22 +416,12 @@ impl Param {
         }
     }
     /// Value now; the parameter's inputs are the element's inputs `first..first + n_inputs`.
+    #[inline]
     #[must_use]
     pub fn value(&self, io: &Io<'_>, first: usize) -> f64 {
         match self {
             Self::Const(v) => *v,
-            Self::Modulated { inputs, law, .. } => {
-                let n = inputs.len();
-                if n > MAX_PARAM_INPUTS {
-                    let v: Vec<f64> = (0..n).map(|k| io.u(first + k)).collect();
-                    return law(io.time(), &v);
-                }
-                let mut buf = [0.0; MAX_PARAM_INPUTS];
-                for (k, b) in buf.iter_mut().take(n).enumerate() {
-                    *b = io.u(first + k);
-                }
-                law(io.time(), &buf[..n])
-            }
+            Self::Modulated { inputs, law, .. } => modulated_value(inputs.len(), law, io, first),
         }
     }
 
@@ -488,6 +478,23 @@ impl Param {
             f(k, (plus - minus) / (2.0 * h));
         }
     }
+}
+
+/// `law(t, u)` with u = the element's inputs `first..first + n` (no allocation for up to
+/// [`MAX_PARAM_INPUTS`] inputs; one input, the common case, read into a register).
+fn modulated_value(n: usize, law: &ParamLaw, io: &Io<'_>, first: usize) -> f64 {
+    if n == 1 {
+        return law(io.time(), &[io.u(first)]);
+    }
+    if n > MAX_PARAM_INPUTS {
+        let v: Vec<f64> = (0..n).map(|k| io.u(first + k)).collect();
+        return law(io.time(), &v);
+    }
+    let mut buf = [0.0; MAX_PARAM_INPUTS];
+    for (k, b) in buf.iter_mut().take(n).enumerate() {
+        *b = io.u(first + k);
+    }
+    law(io.time(), &buf[..n])
 }
 
 /// The step of a central difference at `v`: ∛ε·max(|v|, `floor`), rounded so that v ± h are

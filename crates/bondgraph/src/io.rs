@@ -72,70 +72,83 @@ pub struct Io<'a> {
 
 impl<'a> Io<'a> {
     /// Simulation time.
+    #[inline]
     #[must_use]
     pub fn time(&self) -> f64 {
         self.t
     }
     /// This element's states.
+    #[inline]
     #[must_use]
     pub fn states(&self) -> &[f64] {
         let l = self.layout;
         &self.x[l.state_offset..l.state_offset + l.n_states]
     }
     /// Number of ports.
+    #[inline]
     #[must_use]
     pub fn n_ports(&self) -> usize {
         self.layout.ports.len()
     }
     /// Dimension of port `port`.
+    #[inline]
     #[must_use]
     pub fn dim(&self, port: usize) -> usize {
         self.layout.ports[port].dim
     }
     /// +1 if the bond at `port` points into the element, −1 otherwise.
+    #[inline]
     #[must_use]
     pub fn sign(&self, port: usize) -> f64 {
         self.layout.ports[port].sign
     }
     /// Causality of `port`.
+    #[inline]
     #[must_use]
     pub fn causality(&self, port: usize) -> PortCausality {
         self.layout.ports[port].causality
     }
     /// Effort vector of `port`.
+    #[inline]
     #[must_use]
     pub fn effort(&self, port: usize) -> &[f64] {
         let p = &self.layout.ports[port];
         &self.effort[p.offset..p.offset + p.dim]
     }
     /// Flow vector of `port` (the bond's flow, in the half-arrow's direction).
+    #[inline]
     #[must_use]
     pub fn flow(&self, port: usize) -> &[f64] {
         let p = &self.layout.ports[port];
         &self.flow[p.offset..p.offset + p.dim]
     }
     /// Component `k` of the effort at `port`.
+    #[inline]
     #[must_use]
     pub fn e(&self, port: usize, k: usize) -> f64 {
         self.effort[self.layout.ports[port].offset + k]
     }
     /// Component `k` of the flow *into the element* at `port`.
+    #[inline]
     #[must_use]
     pub fn f_in(&self, port: usize, k: usize) -> f64 {
         let p = &self.layout.ports[port];
         p.sign * self.flow[p.offset + k]
     }
     /// Set component `k` of the effort at `port`.
+    #[inline]
     pub fn set_e(&mut self, port: usize, k: usize, value: f64) {
         let off = self.layout.ports[port].offset;
         self.effort[off + k] = value;
     }
     /// Set component `k` of the flow *into the element* at `port`.
+    #[inline]
     pub fn set_f_in(&mut self, port: usize, k: usize, value: f64) {
         let p = &self.layout.ports[port];
         self.flow[p.offset + k] = p.sign * value;
     }
     /// Signal input `i` (a slice of its dimension).
+    #[inline]
     #[must_use]
     pub fn input(&self, i: usize) -> &[f64] {
         let (src, dim) = self.layout.inputs[i];
@@ -148,11 +161,22 @@ impl<'a> Io<'a> {
         }
     }
     /// First component of signal input `i`.
+    #[inline(always)]
     #[must_use]
     pub fn u(&self, i: usize) -> f64 {
-        self.input(i)[0]
+        // `input(i)[0]` without forming the slice
+        let (src, dim) = self.layout.inputs[i];
+        assert!(dim > 0 || src == Source::Time, "empty signal input");
+        match src {
+            Source::Time => self.t,
+            Source::State(o) => self.x[o],
+            Source::Signal(o) => self.signals[o],
+            Source::Effort(o) => self.effort[o],
+            Source::Flow(o) => self.flow[o],
+        }
     }
     /// Set signal output `i` (component `k`).
+    #[inline]
     pub fn set_y(&mut self, i: usize, k: usize, value: f64) {
         let (off, _) = self.layout.outputs[i];
         self.signals[off + k] = value;

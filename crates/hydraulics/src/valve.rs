@@ -77,12 +77,20 @@ impl Valve {
     /// [−1, 1]) and line pressures `p_a`, `p_b`.
     #[must_use]
     pub fn flows(&self, x_v: f64, p_a: f64, p_b: f64) -> (f64, f64) {
+        (self.line_flow(0, x_v, p_a), self.line_flow(1, x_v, p_b))
+    }
+
+    /// The flow delivered into line `line` (0: A, 1: B) at line pressure `p`: one of
+    /// [`flows`](Self::flows)' pair, computed alone.
+    #[must_use]
+    pub fn line_flow(&self, line: usize, x_v: f64, p: f64) -> f64 {
         let x = x_v.clamp(-1.0, 1.0);
         let r = |dp: f64| self.alpha * x * reg_root(dp, self.p_tr);
-        if x >= 0.0 {
-            (r(self.p_s - p_a), -r(p_b - self.p_t))
-        } else {
-            (r(p_a - self.p_t), -r(self.p_s - p_b))
+        match (line, x >= 0.0) {
+            (0, true) => r(self.p_s - p),
+            (0, false) => r(p - self.p_t),
+            (_, true) => -r(p - self.p_t),
+            (_, false) => -r(self.p_s - p),
         }
     }
 
@@ -150,13 +158,11 @@ impl Element for Valve {
     }
     fn eval(&self, stage: usize, io: &mut Io<'_>) {
         let x = self.x_v.value(io, 0);
-        let (q_a, q_b) = self.flows(x, io.e(0, 0), io.e(1, 0));
-        // delivered into the line: the flow into the valve is its negative
-        if stage == 0 {
-            io.set_f_in(0, 0, -q_a);
-        } else {
-            io.set_f_in(1, 0, -q_b);
-        }
+        // stage 0 sets line A, stage 1 line B; delivered into the line: the flow into the
+        // valve is its negative
+        let line = stage.min(1);
+        let q = self.line_flow(line, x, io.e(line, 0));
+        io.set_f_in(line, 0, -q);
     }
     fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
         let x = self.x_v.value(io, 0);
@@ -204,6 +210,28 @@ pub const KIND: KindDecl = KindDecl::element(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn line_flow_is_bit_identical_to_the_pair_formula() {
+        // the pair as computed before the per-line split (both branches, p_tr = 0 and > 0)
+        for p_tr in [0.0, 2e5] {
+            let v = Valve::new(3e-7, 0.0, 2.1e7, 1e5, p_tr).unwrap();
+            for x_v in [-1.4, -0.63, -1e-9, 0.0, 1e-9, 0.37, 1.0, 2.0] {
+                for (p_a, p_b) in [(5e6, 1.2e7), (2.3e7, 4e4), (1e5, 1e5), (-3e5, 2.1e7)] {
+                    let x = f64::clamp(x_v, -1.0, 1.0);
+                    let r = |dp: f64| v.alpha * x * reg_root(dp, v.p_tr);
+                    let pair = if x >= 0.0 {
+                        (r(v.p_s - p_a), -r(p_b - v.p_t))
+                    } else {
+                        (r(p_a - v.p_t), -r(v.p_s - p_b))
+                    };
+                    let (q_a, q_b) = (v.line_flow(0, x_v, p_a), v.line_flow(1, x_v, p_b));
+                    assert_eq!(q_a.to_bits(), pair.0.to_bits(), "x_v {x_v}, P_A {p_a}");
+                    assert_eq!(q_b.to_bits(), pair.1.to_bits(), "x_v {x_v}, P_B {p_b}");
+                }
+            }
+        }
+    }
 
     /// Eqs. 29–30 written out as printed, with P_r the tank pressure.
     fn paper(alpha: f64, x: f64, p_s: f64, p_t: f64, pp: f64, pr: f64) -> (f64, f64) {

@@ -12,9 +12,36 @@ use crate::kind::KindDecl;
 use crate::local_jacobian::LocalJacobian;
 
 fn dominant(io: &Io<'_>, c: PortCausality) -> usize {
-    (0..io.n_ports())
-        .find(|&p| io.causality(p) == c)
+    io.layout
+        .ports
+        .iter()
+        .position(|p| p.causality == c)
         .unwrap_or(0)
+}
+
+/// Call `$f::<N>(args)` if `dim` is N = 2..=16 (the multibonds of arms: generalized
+/// coordinates, pin velocities) and say whether it did; wider bonds take the general path.
+macro_rules! fixed_width {
+    ($dim:expr, $f:ident, $($arg:expr),*) => {
+        match $dim {
+            2 => { $f::<2>($($arg),*); true }
+            3 => { $f::<3>($($arg),*); true }
+            4 => { $f::<4>($($arg),*); true }
+            5 => { $f::<5>($($arg),*); true }
+            6 => { $f::<6>($($arg),*); true }
+            7 => { $f::<7>($($arg),*); true }
+            8 => { $f::<8>($($arg),*); true }
+            9 => { $f::<9>($($arg),*); true }
+            10 => { $f::<10>($($arg),*); true }
+            11 => { $f::<11>($($arg),*); true }
+            12 => { $f::<12>($($arg),*); true }
+            13 => { $f::<13>($($arg),*); true }
+            14 => { $f::<14>($($arg),*); true }
+            15 => { $f::<15>($($arg),*); true }
+            16 => { $f::<16>($($arg),*); true }
+            _ => false,
+        }
+    };
 }
 
 fn two_stages(
@@ -50,11 +77,44 @@ fn share(values: &mut [f64], layout: &Layout, d: usize) {
         }
         return;
     }
+    if fixed_width!(dim, share_n, values, layout, d) {
+        return;
+    }
     for (p, port) in layout.ports.iter().enumerate() {
         if p != d {
             values.copy_within(from..from + dim, port.offset);
         }
     }
+}
+
+/// [`share`] for bonds of dimension `N`: fixed-size copies (no memmove call per port).
+fn share_n<const N: usize>(values: &mut [f64], layout: &Layout, d: usize) {
+    let from = layout.ports[d].offset;
+    let mut v = [0.0; N];
+    v.copy_from_slice(&values[from..from + N]);
+    for (p, port) in layout.ports.iter().enumerate() {
+        if p != d {
+            values[port.offset..port.offset + N].copy_from_slice(&v);
+        }
+    }
+}
+
+/// [`balance`] for bonds of dimension `N`: the sums 0 + s₁v₁ + s₂v₂ + … (ports in order,
+/// as in place) formed in a fixed-size array.
+fn balance_n<const N: usize>(values: &mut [f64], layout: &Layout, d: usize) {
+    let (to, sd) = (layout.ports[d].offset, layout.ports[d].sign);
+    let mut sum = [0.0; N];
+    for (p, port) in layout.ports.iter().enumerate() {
+        if p != d {
+            let s = -sd * port.sign;
+            let mut v = [0.0; N];
+            v.copy_from_slice(&values[port.offset..port.offset + N]);
+            for (a, x) in sum.iter_mut().zip(v) {
+                *a += s * x;
+            }
+        }
+    }
+    values[to..to + N].copy_from_slice(&sum);
 }
 
 /// Set port `d`'s values so that Σ_p s_p v_p = 0 (the flows of a 0-, the efforts of a
@@ -74,6 +134,9 @@ fn balance(values: &mut [f64], layout: &Layout, d: usize) {
             }
         }
         values[to] = sum;
+        return;
+    }
+    if fixed_width!(dim, balance_n, values, layout, d) {
         return;
     }
     values[to..to + dim].fill(0.0);
@@ -197,6 +260,71 @@ pub const ONE: KindDecl = KindDecl::element(
 mod tests {
     use super::*;
     use crate::check_partials;
+    use crate::element::PortLayout;
+
+    /// The in-place `share` and `balance` before the fixed-width paths (the reference).
+    fn share_ref(values: &mut [f64], layout: &Layout, d: usize) {
+        let (from, dim) = (layout.ports[d].offset, layout.ports[d].dim);
+        for (p, port) in layout.ports.iter().enumerate() {
+            if p != d {
+                values.copy_within(from..from + dim, port.offset);
+            }
+        }
+    }
+    fn balance_ref(values: &mut [f64], layout: &Layout, d: usize) {
+        let (to, dim, sd) = (
+            layout.ports[d].offset,
+            layout.ports[d].dim,
+            layout.ports[d].sign,
+        );
+        values[to..to + dim].fill(0.0);
+        for (p, port) in layout.ports.iter().enumerate() {
+            if p != d {
+                let s = -sd * port.sign;
+                for k in 0..dim {
+                    values[to + k] += s * values[port.offset + k];
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn share_and_balance_are_bit_identical_to_the_in_place_loops() {
+        // widths 1 (scalar path), 2..=16 (fixed-size arrays) and 17, 20 (general path);
+        // 1 to 6 ports, every port dominant in turn, values of mixed signs and magnitudes
+        let signs = [1.0, -1.0, -1.0, 1.0, -1.0, 1.0];
+        for dim in (1..=17).chain([20]) {
+            for n in 1..=6 {
+                let layout = Layout {
+                    ports: (0..n)
+                        .map(|p| PortLayout {
+                            offset: 3 + p * dim,
+                            dim,
+                            sign: signs[p],
+                            causality: PortCausality::EffortOut,
+                        })
+                        .collect(),
+                    ..Layout::default()
+                };
+                let len = 3 + n * dim + 2;
+                let start: Vec<f64> = (0..len)
+                    .map(|k| ((k * 7919 % 113) as f64 - 56.3) * 10f64.powi((k % 9) as i32 - 4))
+                    .collect();
+                for d in 0..n {
+                    type Routine = fn(&mut [f64], &Layout, usize);
+                    let pairs: [(Routine, Routine); 2] =
+                        [(share, share_ref), (balance, balance_ref)];
+                    for (fast, slow) in pairs {
+                        let (mut a, mut b) = (start.clone(), start.clone());
+                        fast(&mut a, &layout, d);
+                        slow(&mut b, &layout, d);
+                        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                        assert_eq!(bits(&a), bits(&b), "dim {dim}, {n} ports, dominant {d}");
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn partials_match_central_differences() {

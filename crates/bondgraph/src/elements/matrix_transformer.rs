@@ -21,19 +21,65 @@ use crate::local_jacobian::LocalJacobian;
 /// The modulus law: fill `t` (n₁×n₂) from time and the element's inputs.
 pub type ModulusLaw = Box<dyn Fn(&Io<'_>, &mut DMatrix<f64>)>;
 
+/// Widest port whose values [`apply_effort`] and [`apply_flow`] gather on the stack.
+const MAX_LOCAL: usize = 16;
+
 /// `e₁ = T·e₂` on ports 0 and 1 of `io` (for matrix MTFs of other crates too).
 pub fn apply_effort(io: &mut Io<'_>, t: &DMatrix<f64>) {
-    for i in 0..t.nrows() {
-        let e: f64 = (0..t.ncols()).map(|j| t[(i, j)] * io.e(1, j)).sum();
-        io.set_e(0, i, e);
+    let (n1, n2) = t.shape();
+    if n2 > MAX_LOCAL || n2 == 0 || n1 == 0 {
+        for i in 0..n1 {
+            let e: f64 = (0..n2).map(|j| t[(i, j)] * io.e(1, j)).sum();
+            io.set_e(0, i, e);
+        }
+        return;
+    }
+    // e₂ on the stack, then e₁ += T_:j·e₂_j column by column (T is column-major): each
+    // e₁_i is the sum Σ_j T_ij e₂_j in the same order as `Iterator::sum`, which starts at
+    // −0 (−0 + a = a exactly, so the first term is stored)
+    let (o1, o2) = (io.layout.ports[0].offset, io.layout.ports[1].offset);
+    let mut buf = [0.0; MAX_LOCAL];
+    let e2 = &mut buf[..n2];
+    e2.copy_from_slice(&io.effort[o2..o2 + n2]);
+    let e1 = &mut io.effort[o1..o1 + n1];
+    let mut cols = t.as_slice().chunks_exact(n1).zip(&*e2);
+    if let Some((col, &e)) = cols.next() {
+        for (y, tij) in e1.iter_mut().zip(col) {
+            *y = tij * e;
+        }
+    }
+    for (col, &e) in cols {
+        for (y, tij) in e1.iter_mut().zip(col) {
+            *y += tij * e;
+        }
     }
 }
 
 /// `f_in₂ = −Tᵀ·f_in₁` on ports 0 and 1 of `io`.
 pub fn apply_flow(io: &mut Io<'_>, t: &DMatrix<f64>) {
-    for j in 0..t.ncols() {
-        let f: f64 = (0..t.nrows()).map(|i| t[(i, j)] * io.f_in(0, i)).sum();
-        io.set_f_in(1, j, -f);
+    let (n1, n2) = t.shape();
+    if n1 > MAX_LOCAL || n1 == 0 {
+        for j in 0..n2 {
+            let f: f64 = (0..n1).map(|i| t[(i, j)] * io.f_in(0, i)).sum();
+            io.set_f_in(1, j, -f);
+        }
+        return;
+    }
+    // f_in₁ on the stack, then column j of T (contiguous) times it: Σ_i T_ij f_in₁_i
+    let (p1, p2) = (&io.layout.ports[0], &io.layout.ports[1]);
+    let mut buf = [0.0; MAX_LOCAL];
+    let f1 = &mut buf[..n1];
+    for (b, f) in f1.iter_mut().zip(&io.flow[p1.offset..p1.offset + n1]) {
+        *b = p1.sign * f;
+    }
+    let s2 = p2.sign;
+    for (col, f2) in t
+        .as_slice()
+        .chunks_exact(n1)
+        .zip(&mut io.flow[p2.offset..p2.offset + n2])
+    {
+        let f: f64 = col.iter().zip(&*f1).map(|(tij, f)| tij * f).sum();
+        *f2 = s2 * -f;
     }
 }
 
@@ -226,6 +272,76 @@ fn build(p: &dyn Params) -> Result<Box<dyn Element>, BuildError> {
 mod tests {
     use super::*;
     use crate::check_partials;
+    use crate::element::{Layout, PortLayout};
+
+    #[test]
+    fn apply_effort_and_flow_are_bit_identical_to_the_index_loops() {
+        // the loops before the stack copies (through Io's accessors) are the reference;
+        // shapes on both sides of the stack buffer's width (16)
+        for (n1, n2) in [
+            (1, 1),
+            (9, 2),
+            (9, 6),
+            (2, 9),
+            (16, 16),
+            (17, 3),
+            (3, 17),
+            (20, 20),
+        ] {
+            let t = DMatrix::from_fn(n1, n2, |i, j| {
+                ((i * 31 + j * 17) % 23) as f64 * 0.37 - 4.1 + 1e-3 * (i as f64 - j as f64)
+            });
+            let layout = Layout {
+                ports: vec![
+                    PortLayout {
+                        offset: 1,
+                        dim: n1,
+                        sign: -1.0,
+                        causality: PortCausality::EffortOut,
+                    },
+                    PortLayout {
+                        offset: 2 + n1,
+                        dim: n2,
+                        sign: 1.0,
+                        causality: PortCausality::FlowOut,
+                    },
+                ],
+                ..Layout::default()
+            };
+            let len = 3 + n1 + n2;
+            let fill = |k: usize, s: f64| (k as f64 * s).sin() * 10f64.powi((k % 7) as i32 - 3);
+            let (e0, f0): (Vec<f64>, Vec<f64>) = (
+                (0..len).map(|k| fill(k, 1.3)).collect(),
+                (0..len).map(|k| fill(k, 0.7)).collect(),
+            );
+            let run = |fast: bool| {
+                let (mut e, mut f, mut sig) = (e0.clone(), f0.clone(), Vec::new());
+                let mut io = Io {
+                    t: 0.0,
+                    x: &[],
+                    effort: &mut e,
+                    flow: &mut f,
+                    signals: &mut sig,
+                    layout: &layout,
+                };
+                if fast {
+                    apply_effort(&mut io, &t);
+                    apply_flow(&mut io, &t);
+                } else {
+                    for i in 0..n1 {
+                        let v: f64 = (0..n2).map(|j| t[(i, j)] * io.e(1, j)).sum();
+                        io.set_e(0, i, v);
+                    }
+                    for j in 0..n2 {
+                        let v: f64 = (0..n1).map(|i| t[(i, j)] * io.f_in(0, i)).sum();
+                        io.set_f_in(1, j, -v);
+                    }
+                }
+                e.iter().chain(&f).map(|v| v.to_bits()).collect::<Vec<_>>()
+            };
+            assert_eq!(run(true), run(false), "T {n1}×{n2}");
+        }
+    }
 
     #[test]
     fn partials_match_central_differences() {

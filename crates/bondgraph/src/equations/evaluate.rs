@@ -3,7 +3,16 @@
 
 use super::{Probe, StateEquations, Var, Workspace};
 use crate::bond::ElementId;
-use crate::element::Io;
+use crate::element::{Io, Layout};
+
+/// The layout a view starts with before its first element.
+static EMPTY: Layout = Layout {
+    ports: Vec::new(),
+    inputs: Vec::new(),
+    outputs: Vec::new(),
+    state_offset: 0,
+    n_states: 0,
+};
 
 impl StateEquations {
     /// dx/dt = f(t, x).
@@ -30,8 +39,23 @@ impl StateEquations {
         dx: &mut [f64],
     ) {
         self.run_stages(order, t, x, effort, flow, signals);
-        let with_states = (0..self.layouts.len()).filter(|&id| self.layouts[id].n_states > 0);
-        self.derivatives_of(with_states, t, x, effort, flow, signals, dx);
+        let mut io = Io {
+            t,
+            x,
+            effort,
+            flow,
+            signals,
+            layout: &EMPTY,
+        };
+        for (id, l) in self.layouts.iter().enumerate() {
+            if l.n_states > 0 {
+                io.layout = l;
+                self.graph
+                    .node(id)
+                    .element
+                    .derivatives(&io, &mut dx[l.state_offset..l.state_offset + l.n_states]);
+            }
+        }
     }
 
     /// Run the stages `order` (element, stage) at (t, x), in that order.
@@ -45,15 +69,17 @@ impl StateEquations {
         flow: &mut [f64],
         signals: &mut [f64],
     ) {
+        // one view, re-pointed at each stage's layout
+        let mut io = Io {
+            t,
+            x,
+            effort,
+            flow,
+            signals,
+            layout: &EMPTY,
+        };
         for &(id, stage) in order {
-            let mut io = Io {
-                t,
-                x,
-                effort,
-                flow,
-                signals,
-                layout: &self.layouts[id],
-            };
+            io.layout = &self.layouts[id];
             self.graph.node(id).element.eval(stage, &mut io);
         }
     }
@@ -72,16 +98,17 @@ impl StateEquations {
         signals: &mut [f64],
         dx: &mut [f64],
     ) {
+        let mut io = Io {
+            t,
+            x,
+            effort,
+            flow,
+            signals,
+            layout: &EMPTY,
+        };
         for id in ids {
             let l = &self.layouts[id];
-            let io = Io {
-                t,
-                x,
-                effort,
-                flow,
-                signals,
-                layout: l,
-            };
+            io.layout = l;
             self.graph
                 .node(id)
                 .element
