@@ -2,15 +2,22 @@
 
 use pulp::{Arch, Simd, WithSimd};
 
-use super::{axpy, axpy2, axpy_twice, nonzero_rows, pivot, widen, Pattern, Singular};
+use super::{
+    axpy, axpy2, axpy_twice, non_finite_bits, nonzero_rows, padded_end, pivot_real, widen, Pattern,
+    Singular, PAD,
+};
 
 /// A real n×n matrix and, after [`RealLu::factor`], its factors P·A = L·U in place.
 #[derive(Clone, Debug)]
 pub(crate) struct RealLu {
     pub(super) n: usize,
+    /// Column stride: n rows and [`PAD`] rows of padding.
+    pub(super) ld: usize,
     /// Column-major; L below the diagonal (unit diagonal implied), U on and above it.
     pub(super) a: Vec<f64>,
     pub(super) pat: Pattern,
+    /// The trailing columns to update at the current elimination step.
+    cols: Vec<usize>,
     arch: Arch,
 }
 
@@ -21,21 +28,26 @@ impl RealLu {
 
     /// With a given instruction set (the tests compare them).
     pub(super) fn with_arch(n: usize, arch: Arch) -> Self {
+        let ld = n + PAD;
         Self {
             n,
-            a: vec![0.0; n * n],
+            ld,
+            a: vec![0.0; ld * n],
             pat: Pattern::new(n),
+            cols: vec![0; n],
             arch,
         }
     }
 
     /// Set the matrix to `diag·I − J` (J column-major), ready for [`Self::factor`].
     pub(crate) fn set_shifted(&mut self, diag: f64, jac: &[f64]) {
-        for (dst, &j) in self.a.iter_mut().zip(jac) {
-            *dst = -j;
-        }
-        for k in 0..self.n {
-            self.a[k * self.n + k] += diag;
+        let (n, ld) = (self.n, self.ld);
+        for k in 0..n {
+            let (dst, src) = (&mut self.a[k * ld..k * ld + n], &jac[k * n..k * n + n]);
+            for (d, &j) in dst.iter_mut().zip(src) {
+                *d = -j;
+            }
+            dst[k] += diag;
         }
     }
 
@@ -54,56 +66,79 @@ impl RealLu {
 
     #[inline(always)]
     fn factor_kernel<S: Simd>(&mut self, simd: S) -> Result<(), Singular> {
-        let n = self.n;
-        let pat = &mut self.pat;
+        let (n, ld) = (self.n, self.ld);
+        let Self { a, pat, cols, .. } = self;
+        pat.finite = true;
         for k in 0..n {
-            let (left, right) = self.a.split_at_mut((k + 1) * n);
-            let colk = &mut left[k * n..];
-            let p = k + pivot(n - k, |i| colk[k + i].abs()).ok_or(Singular)?;
+            let (left, right) = a.split_at_mut((k + 1) * ld);
+            let colk = &mut left[k * ld..];
+            let p = k + pivot_real(&colk[k..n]).ok_or(Singular)?;
             pat.piv[k] = p;
             colk.swap(k, p);
             let inv = 1.0 / colk[k];
-            for v in &mut colk[k + 1..] {
+            // l = a·(1/pivot); `bad` ≠ 0 if an l (or, below, a u) is not finite.
+            let mut bad = 0;
+            for v in &mut colk[k + 1..n] {
                 *v *= inv;
+                bad |= non_finite_bits(*v);
             }
-            let (lo, hi) = nonzero_rows(k + 1, n, |i| colk[i] != 0.0);
+            let l = &colk[k + 1..n];
+            let (pos, rpos) = (
+                l.iter().position(|v| *v != 0.0),
+                l.iter().rposition(|v| *v != 0.0),
+            );
+            let (lo, hi) = nonzero_rows(k + 1, n, pos, rpos);
             let (lo, hi) = widen(lo, hi, k + 1, n);
             pat.lo[k] = lo;
             pat.hi[k] = hi;
-            if lo == hi {
+            // Pass 1 over the trailing columns: rows k and p interchanged, the columns with a
+            // non-zero u = a[k, j] listed (u = NaN included), u tested for finiteness.
+            let mut count = 0;
+            for (j, colj) in right.chunks_exact_mut(ld).enumerate() {
                 if p != k {
-                    for colj in right.chunks_exact_mut(n) {
-                        colj.swap(k, p);
+                    colj.swap(k, p);
+                }
+                let u = colj[k];
+                bad |= non_finite_bits(u);
+                cols[count] = j;
+                count += usize::from(u != 0.0);
+            }
+            if bad != 0 {
+                // An infinite or NaN l or u: x − l·u over every row and column, as the
+                // textbook (0·∞ and NaN·0 are NaN, so nothing may be skipped).
+                pat.finite = false;
+                let l = &colk[k + 1..n];
+                for colj in right.chunks_exact_mut(ld) {
+                    let u = colj[k];
+                    for (x, &l) in colj[k + 1..n].iter_mut().zip(l) {
+                        *x -= l * u;
                     }
                 }
                 continue;
             }
-            // One pass over the trailing columns: rows k and p interchanged, and those with
-            // a non-zero (not NaN) in row k updated, two at a time (the first of a pair
-            // waits in `pending`).
-            let l = &colk[lo..hi];
-            let mut pending: Option<&mut [f64]> = None;
-            for colj in right.chunks_exact_mut(n) {
-                if p != k {
-                    colj.swap(k, p);
-                }
-                if colj[k].abs() > 0.0 {
-                    match pending.take() {
-                        None => pending = Some(colj),
-                        Some(x) => {
-                            let (a, b) = (x[k], colj[k]);
-                            axpy2(simd, &mut x[lo..hi], &mut colj[lo..hi], l, a, b);
-                        }
-                    }
-                }
+            if lo == hi {
+                continue;
             }
-            if let Some(x) = pending {
-                let a = x[k];
-                axpy(simd, &mut x[lo..hi], l, a);
+            // Pass 2: the listed columns, two at a time sharing the loads of l, over the
+            // non-zero rows of l widened to a multiple of four (zero rows or padding).
+            let end = padded_end(lo, hi);
+            let l = &colk[lo..end];
+            let mut pairs = cols[..count].chunks_exact(2);
+            for pair in &mut pairs {
+                let (j0, j1) = (pair[0], pair[1]);
+                let (x, y) = right.split_at_mut(j1 * ld);
+                let (x, y) = (&mut x[j0 * ld..j0 * ld + ld], &mut y[..ld]);
+                let (u0, u1) = (x[k], y[k]);
+                axpy2(simd, &mut x[lo..end], &mut y[lo..end], l, u0, u1);
+            }
+            if let [j] = *pairs.remainder() {
+                let x = &mut right[j * ld..j * ld + ld];
+                let u = x[k];
+                axpy(simd, &mut x[lo..end], l, u);
             }
         }
         for k in 0..n {
-            let u = &self.a[k * n..k * n + k];
+            let u = &a[k * ld..k * ld + k];
             pat.top[k] = u.iter().position(|v| *v != 0.0).unwrap_or(k);
         }
         Ok(())
@@ -124,28 +159,41 @@ impl RealLu {
 
     #[inline(always)]
     fn solve_kernel<S: Simd>(&self, simd: S, b: &mut [f64]) {
-        let (n, a, pat) = (self.n, &self.a, &self.pat);
-        // L y = P b, interchanging as the factorisation did.
+        let (n, ld, a, pat) = (self.n, self.ld, &self.a, &self.pat);
+        // L y = P b, interchanging as the factorisation did. The zeros of L and of b are
+        // skipped only where that is exact: finite factors and a finite b[k].
         for k in 0..n {
             b.swap(k, pat.piv[k]);
             let bk = b[k];
-            if bk != 0.0 {
-                let (lo, hi) = (pat.lo[k], pat.hi[k]);
-                axpy(simd, &mut b[lo..hi], &a[k * n + lo..k * n + hi], bk);
+            if pat.finite && bk.is_finite() {
+                if bk != 0.0 {
+                    let (lo, hi) = (pat.lo[k], pat.hi[k]);
+                    axpy(simd, &mut b[lo..hi], &a[k * ld + lo..k * ld + hi], bk);
+                }
+            } else {
+                axpy(simd, &mut b[k + 1..n], &a[k * ld + k + 1..k * ld + n], bk);
             }
         }
         // U x = y, column-oriented, columns k1 = k0 + 1 and k0 in one pass over the rows
-        // above k0 (each row still receives k1's term first).
+        // above k0 (each row still receives k1's term first); the zeros of U above top are
+        // skipped for finite x only.
         let mut k = n;
         while k >= 2 {
             let (k1, k0) = (k - 1, k - 2);
-            b[k1] /= a[k1 * n + k1];
+            b[k1] /= a[k1 * ld + k1];
             let x1 = b[k1];
-            b[k0] -= a[k1 * n + k0] * x1;
-            b[k0] /= a[k0 * n + k0];
+            b[k0] -= a[k1 * ld + k0] * x1;
+            b[k0] /= a[k0 * ld + k0];
             let x0 = b[k0];
-            let top = widen(pat.top[k1].min(pat.top[k0]), k0, 0, k0).0;
-            let (u1, u0) = (&a[k1 * n + top..k1 * n + k0], &a[k0 * n + top..k0 * n + k0]);
+            let top = if x1.is_finite() && x0.is_finite() {
+                widen(pat.top[k1].min(pat.top[k0]), k0, 0, k0).0
+            } else {
+                0
+            };
+            let (u1, u0) = (
+                &a[k1 * ld + top..k1 * ld + k0],
+                &a[k0 * ld + top..k0 * ld + k0],
+            );
             axpy_twice(&mut b[top..k0], u1, x1, u0, x0);
             k -= 2;
         }
