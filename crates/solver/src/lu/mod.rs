@@ -244,7 +244,9 @@ fn lane_max(chunks: impl Iterator<Item = [f64; 4]>, rest: impl Iterator<Item = f
 #[inline(always)]
 fn pivot(best: f64, mut sizes: impl Iterator<Item = f64> + Clone) -> Option<usize> {
     let first = sizes.clone().next()?;
-    if best > 0.0 && best.is_finite() && !first.is_nan() {
+    // (best < ∞ rather than is_finite(): best is not NaN, and two comparisons are cheaper.)
+    #[allow(clippy::float_cmp)]
+    if best > 0.0 && best < f64::INFINITY && first == first {
         // Exact: best is one of the sizes.
         #[allow(clippy::float_cmp)]
         sizes.position(|s| s == best)

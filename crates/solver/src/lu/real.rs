@@ -16,8 +16,6 @@ pub(crate) struct RealLu {
     /// Column-major; L below the diagonal (unit diagonal implied), U on and above it.
     pub(super) a: Vec<f64>,
     pub(super) pat: Pattern,
-    /// The trailing columns to update at the current elimination step.
-    cols: Vec<usize>,
     arch: Arch,
 }
 
@@ -34,7 +32,6 @@ impl RealLu {
             ld,
             a: vec![0.0; ld * n],
             pat: Pattern::new(n),
-            cols: vec![0; n],
             arch,
         }
     }
@@ -67,7 +64,7 @@ impl RealLu {
     #[inline(always)]
     fn factor_kernel<S: Simd>(&mut self, simd: S) -> Result<(), Singular> {
         let (n, ld) = (self.n, self.ld);
-        let Self { a, pat, cols, .. } = self;
+        let Self { a, pat, .. } = self;
         pat.finite = true;
         for k in 0..n {
             let (left, right) = a.split_at_mut((k + 1) * ld);
@@ -76,7 +73,7 @@ impl RealLu {
             pat.piv[k] = p;
             colk.swap(k, p);
             let inv = 1.0 / colk[k];
-            // l = a·(1/pivot); `bad` ≠ 0 if an l (or, below, a u) is not finite.
+            // l = a·(1/pivot); `bad` ≠ 0 if an l is not finite.
             let mut bad = 0;
             for v in &mut colk[k + 1..n] {
                 *v *= inv;
@@ -91,50 +88,51 @@ impl RealLu {
             let (lo, hi) = widen(lo, hi, k + 1, n);
             pat.lo[k] = lo;
             pat.hi[k] = hi;
-            // Pass 1 over the trailing columns: rows k and p interchanged, the columns with a
-            // non-zero u = a[k, j] listed (u = NaN included), u tested for finiteness.
-            let mut count = 0;
-            for (j, colj) in right.chunks_exact_mut(ld).enumerate() {
-                if p != k {
-                    colj.swap(k, p);
+            // Rows k and p interchanged in the trailing columns (LINPACK's layout).
+            if p != k {
+                for x in right.chunks_exact_mut(ld) {
+                    x.swap(k, p);
                 }
-                let u = colj[k];
-                bad |= non_finite_bits(u);
-                cols[count] = j;
-                count += usize::from(u != 0.0);
             }
-            if bad != 0 {
-                // An infinite or NaN l or u: x − l·u over every row and column, as the
-                // textbook (0·∞ and NaN·0 are NaN, so nothing may be skipped).
-                pat.finite = false;
-                let l = &colk[k + 1..n];
-                for colj in right.chunks_exact_mut(ld) {
-                    let u = colj[k];
-                    for (x, &l) in colj[k + 1..n].iter_mut().zip(l) {
-                        *x -= l * u;
-                    }
-                }
-                continue;
-            }
-            if lo == hi {
-                continue;
-            }
-            // Pass 2: the listed columns, two at a time sharing the loads of l, over the
-            // non-zero rows of l widened to a multiple of four (zero rows or padding).
+            // The trailing columns, two adjacent ones at a time (sharing the loads of l): if
+            // the pair's u = a[k, j] and the l are finite, the columns with u ≠ 0 updated
+            // over the non-zero rows of l widened to a multiple of four (zero rows of l or
+            // padding); otherwise the textbook's x − l·u over every row (0·∞ and NaN·0 are
+            // NaN: nothing may be skipped).
+            let lfin = bad == 0;
             let end = padded_end(lo, hi);
-            let l = &colk[lo..end];
-            let mut pairs = cols[..count].chunks_exact(2);
+            let (l, lk) = (&colk[lo..end], &colk[k + 1..n]);
+            // Known to the compiler, these bounds leave the pair loop without bounds checks.
+            assert!(k < ld && lo <= end && end <= ld);
+            let mut pairs = right.chunks_exact_mut(2 * ld);
             for pair in &mut pairs {
-                let (j0, j1) = (pair[0], pair[1]);
-                let (x, y) = right.split_at_mut(j1 * ld);
-                let (x, y) = (&mut x[j0 * ld..j0 * ld + ld], &mut y[..ld]);
+                let (x, y) = pair.split_at_mut(ld);
                 let (u0, u1) = (x[k], y[k]);
-                axpy2(simd, &mut x[lo..end], &mut y[lo..end], l, u0, u1);
+                if lfin && (u0 - u0) + (u1 - u1) == 0.0 {
+                    let (xs, ys) = (&mut x[lo..end], &mut y[lo..end]);
+                    match (u0 != 0.0, u1 != 0.0) {
+                        (true, true) => axpy2(simd, xs, ys, l, u0, u1),
+                        (false, false) => {}
+                        (true, false) => axpy(simd, xs, l, u0),
+                        (false, true) => axpy(simd, ys, l, u1),
+                    }
+                } else {
+                    pat.finite = false;
+                    textbook_update(x, lk, k);
+                    textbook_update(y, lk, k);
+                }
             }
-            if let [j] = *pairs.remainder() {
-                let x = &mut right[j * ld..j * ld + ld];
+            let x = pairs.into_remainder();
+            if x.len() == ld {
                 let u = x[k];
-                axpy(simd, &mut x[lo..end], l, u);
+                if lfin && u - u == 0.0 {
+                    if u != 0.0 {
+                        axpy(simd, &mut x[lo..end], l, u);
+                    }
+                } else {
+                    pat.finite = false;
+                    textbook_update(x, lk, k);
+                }
             }
         }
         for k in 0..n {
@@ -200,5 +198,17 @@ impl RealLu {
         if k == 1 {
             b[0] /= a[0];
         }
+    }
+}
+
+/// x − l·u on rows k + 1.. of column x (`l` = rows k + 1..n of column k), the textbook's
+/// step for one column. Out of line: inlined, its pointers crowded the registers of the
+/// update loop.
+#[cold]
+#[inline(never)]
+fn textbook_update(x: &mut [f64], l: &[f64], k: usize) {
+    let u = x[k];
+    for (x, &l) in x[k + 1..].iter_mut().zip(l) {
+        *x -= l * u;
     }
 }
