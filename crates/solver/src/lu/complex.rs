@@ -20,8 +20,6 @@ pub(crate) struct ComplexLu {
     pub(super) re: Vec<f64>,
     pub(super) im: Vec<f64>,
     pub(super) pat: Pattern,
-    /// The trailing columns to update at the current elimination step.
-    cols: Vec<usize>,
     arch: Arch,
 }
 
@@ -38,7 +36,6 @@ impl ComplexLu {
             re: vec![0.0; ld * n],
             im: vec![0.0; ld * n],
             pat: Pattern::new(n),
-            cols: vec![0; n],
             arch,
         }
     }
@@ -75,10 +72,7 @@ impl ComplexLu {
     #[inline(always)]
     fn factor_kernel<S: Simd>(&mut self, simd: S) -> Result<(), Singular> {
         let (n, ld) = (self.n, self.ld);
-        let Self {
-            re, im, pat, cols, ..
-        } = self;
-        pat.finite = true;
+        let Self { re, im, pat, .. } = self;
         for k in 0..n {
             let (left_re, right_re) = re.split_at_mut((k + 1) * ld);
             let (left_im, right_im) = im.split_at_mut((k + 1) * ld);
@@ -92,12 +86,17 @@ impl ComplexLu {
             let (cr, ci) = (kr[k], ki[k]);
             let ns = cr * cr + ci * ci;
             let (ir, ii) = ((1.0 * cr + 0.0 * ci) / ns, (0.0 * cr - 1.0 * ci) / ns);
+            // `bad` ≠ 0 if an l is not finite.
             let mut bad = 0;
             for (r, m) in kr[k + 1..n].iter_mut().zip(&mut ki[k + 1..n]) {
                 let (vr, vi) = (*r, *m);
                 *r = vr * ir - vi * ii;
                 *m = vr * ii + vi * ir;
                 bad |= non_finite_bits(*r) | non_finite_bits(*m);
+            }
+            // A non-finite l: refused, as by the textbook LU (see `mod.rs`).
+            if bad != 0 {
+                return Err(Singular);
             }
             let (lr, li) = (&kr[k + 1..n], &ki[k + 1..n]);
             let nonzero = |(r, i): (&f64, &f64)| *r != 0.0 || *i != 0.0;
@@ -107,68 +106,63 @@ impl ComplexLu {
             let (lo, hi) = widen(lo, hi, k + 1, n);
             pat.lo[k] = lo;
             pat.hi[k] = hi;
-            // Pass 1: interchange, list the columns with u ≠ 0, test u's finiteness.
-            let trailing = right_re
-                .chunks_exact_mut(ld)
-                .zip(right_im.chunks_exact_mut(ld));
-            let mut count = 0;
-            for (j, (cr, ci)) in trailing.enumerate() {
-                if p != k {
+            let end = padded_end(lo, hi);
+            // Known to the compiler, these bounds leave the loops below without bounds
+            // checks.
+            assert!(k < ld && p < ld && lo <= end && end <= ld);
+            // Rows k and p interchanged in the trailing columns, then the update by adjacent
+            // pairs of columns, as in the real kernel.
+            if p != k {
+                for (cr, ci) in right_re
+                    .chunks_exact_mut(ld)
+                    .zip(right_im.chunks_exact_mut(ld))
+                {
                     cr.swap(k, p);
                     ci.swap(k, p);
                 }
-                let (ur, ui) = (cr[k], ci[k]);
-                bad |= non_finite_bits(ur) | non_finite_bits(ui);
-                cols[count] = j;
-                count += usize::from(ur != 0.0 || ui != 0.0);
-            }
-            if bad != 0 {
-                // Not finite: every row and column, as the textbook.
-                pat.finite = false;
-                let (lr, li) = (&kr[k + 1..n], &ki[k + 1..n]);
-                let trailing = right_re
-                    .chunks_exact_mut(ld)
-                    .zip(right_im.chunks_exact_mut(ld));
-                for (cr, ci) in trailing {
-                    let (ur, ui) = (cr[k], ci[k]);
-                    let x = cr[k + 1..n].iter_mut().zip(&mut ci[k + 1..n]);
-                    for ((xr, xi), (&lr, &li)) in x.zip(lr.iter().zip(li)) {
-                        *xr -= lr * ur - li * ui;
-                        *xi -= lr * ui + li * ur;
-                    }
-                }
-                continue;
             }
             if lo == hi {
                 continue;
             }
-            // Pass 2: the listed columns, two at a time, rows widened (see the real kernel).
-            let end = padded_end(lo, hi);
             let (lr, li) = (&kr[lo..end], &ki[lo..end]);
-            let mut pairs = cols[..count].chunks_exact(2);
-            for pair in &mut pairs {
-                let (j0, j1) = (pair[0], pair[1]);
-                let (xr, yr) = right_re.split_at_mut(j1 * ld);
-                let (xi, yi) = right_im.split_at_mut(j1 * ld);
-                let (xr, yr) = (&mut xr[j0 * ld..j0 * ld + ld], &mut yr[..ld]);
-                let (xi, yi) = (&mut xi[j0 * ld..j0 * ld + ld], &mut yi[..ld]);
+            let mut pairs = right_re
+                .chunks_exact_mut(2 * ld)
+                .zip(right_im.chunks_exact_mut(2 * ld));
+            for (pr, pi) in &mut pairs {
+                let ((xr, yr), (xi, yi)) = (pr.split_at_mut(ld), pi.split_at_mut(ld));
                 let (a, b) = ((xr[k], xi[k]), (yr[k], yi[k]));
                 let (xr, xi) = (&mut xr[lo..end], &mut xi[lo..end]);
                 let (yr, yi) = (&mut yr[lo..end], &mut yi[lo..end]);
-                caxpy2(simd, xr, xi, yr, yi, lr, li, a, b);
+                match (a.0 != 0.0 || a.1 != 0.0, b.0 != 0.0 || b.1 != 0.0) {
+                    (true, true) => caxpy2(simd, xr, xi, yr, yi, lr, li, a, b),
+                    (false, false) => {}
+                    (true, false) => caxpy(simd, xr, xi, lr, li, a),
+                    (false, true) => caxpy(simd, yr, yi, lr, li, b),
+                }
             }
-            if let [j] = *pairs.remainder() {
-                let xr = &mut right_re[j * ld..j * ld + ld];
-                let xi = &mut right_im[j * ld..j * ld + ld];
+            // The odd column left over (the zip's remainders are not exposed).
+            let m = right_re.len() / ld;
+            if m % 2 == 1 {
+                let xr = &mut right_re[(m - 1) * ld..m * ld];
+                let xi = &mut right_im[(m - 1) * ld..m * ld];
                 let a = (xr[k], xi[k]);
-                caxpy(simd, &mut xr[lo..end], &mut xi[lo..end], lr, li, a);
+                if a.0 != 0.0 || a.1 != 0.0 {
+                    caxpy(simd, &mut xr[lo..end], &mut xi[lo..end], lr, li, a);
+                }
             }
         }
+        // U: where its columns start, and whether it is finite (if not: refused, as by the
+        // textbook LU).
+        let mut bad = 0;
         for k in 0..n {
             let (ur, ui) = (&re[k * ld..k * ld + k], &im[k * ld..k * ld + k]);
             pat.top[k] = (0..k)
                 .position(|i| ur[i] != 0.0 || ui[i] != 0.0)
                 .unwrap_or(k);
+            bad |= ur.iter().chain(ui).fold(0, |b, &v| b | non_finite_bits(v));
+        }
+        if bad != 0 {
+            return Err(Singular);
         }
         Ok(())
     }
@@ -189,16 +183,16 @@ impl ComplexLu {
     #[inline(always)]
     fn solve_kernel<S: Simd>(&self, simd: S, br: &mut [f64], bi: &mut [f64]) {
         let (n, ld, re, im, pat) = (self.n, self.ld, &self.re, &self.im, &self.pat);
-        // As the real solve: zeros skipped for finite factors and a finite b[k] only.
+        // As the real solve: b[k] = 0 skipped, the zeros of L for a finite b[k] only.
         for k in 0..n {
             let p = pat.piv[k];
             br.swap(k, p);
             bi.swap(k, p);
             let x = (br[k], bi[k]);
-            let (lo, hi) = if pat.finite && x.0.is_finite() && x.1.is_finite() {
-                if x.0 == 0.0 && x.1 == 0.0 {
-                    continue;
-                }
+            if x.0 == 0.0 && x.1 == 0.0 {
+                continue;
+            }
+            let (lo, hi) = if x.0.is_finite() && x.1.is_finite() {
                 (pat.lo[k], pat.hi[k])
             } else {
                 (k + 1, n)

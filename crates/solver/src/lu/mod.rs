@@ -327,9 +327,6 @@ struct Pattern {
     hi: Vec<usize>,
     /// Column k of U is zero above row top[k].
     top: Vec<usize>,
-    /// Every entry of L and U is finite: only then are the zeros of L skipped in the solves
-    /// (NaN·0 and ∞·0 are NaN).
-    finite: bool,
 }
 
 impl Pattern {
@@ -339,7 +336,6 @@ impl Pattern {
             lo: vec![0; n],
             hi: vec![0; n],
             top: vec![0; n],
-            finite: true,
         }
     }
 }

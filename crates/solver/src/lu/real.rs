@@ -65,7 +65,6 @@ impl RealLu {
     fn factor_kernel<S: Simd>(&mut self, simd: S) -> Result<(), Singular> {
         let (n, ld) = (self.n, self.ld);
         let Self { a, pat, .. } = self;
-        pat.finite = true;
         for k in 0..n {
             let (left, right) = a.split_at_mut((k + 1) * ld);
             let colk = &mut left[k * ld..];
@@ -73,11 +72,15 @@ impl RealLu {
             pat.piv[k] = p;
             colk.swap(k, p);
             let inv = 1.0 / colk[k];
-            // l = a·(1/pivot); `bad` ≠ 0 if an l is not finite.
+            // l = a·(1/pivot). A non-finite l: the textbook LU refuses the matrix (see
+            // `mod.rs`), so does this one, before skipping anything.
             let mut bad = 0;
             for v in &mut colk[k + 1..n] {
                 *v *= inv;
                 bad |= non_finite_bits(*v);
+            }
+            if bad != 0 {
+                return Err(Singular);
             }
             let l = &colk[k + 1..n];
             let (pos, rpos) = (
@@ -88,56 +91,51 @@ impl RealLu {
             let (lo, hi) = widen(lo, hi, k + 1, n);
             pat.lo[k] = lo;
             pat.hi[k] = hi;
+            let end = padded_end(lo, hi);
+            // Known to the compiler, these bounds leave the loops below without bounds
+            // checks.
+            assert!(k < ld && p < ld && lo <= end && end <= ld);
             // Rows k and p interchanged in the trailing columns (LINPACK's layout).
             if p != k {
                 for x in right.chunks_exact_mut(ld) {
                     x.swap(k, p);
                 }
             }
-            // The trailing columns, two adjacent ones at a time (sharing the loads of l): if
-            // the pair's u = a[k, j] and the l are finite, the columns with u ≠ 0 updated
-            // over the non-zero rows of l widened to a multiple of four (zero rows of l or
-            // padding); otherwise the textbook's x − l·u over every row (0·∞ and NaN·0 are
-            // NaN: nothing may be skipped).
-            let lfin = bad == 0;
-            let end = padded_end(lo, hi);
-            let (l, lk) = (&colk[lo..end], &colk[k + 1..n]);
-            // Known to the compiler, these bounds leave the pair loop without bounds checks.
-            assert!(k < ld && lo <= end && end <= ld);
+            if lo == hi {
+                continue;
+            }
+            // The trailing columns, two adjacent ones at a time (sharing the loads of l),
+            // those with u = a[k, j] ≠ 0 updated over the non-zero rows of l widened to a
+            // multiple of four (zero rows of l or padding).
+            let l = &colk[lo..end];
             let mut pairs = right.chunks_exact_mut(2 * ld);
             for pair in &mut pairs {
                 let (x, y) = pair.split_at_mut(ld);
                 let (u0, u1) = (x[k], y[k]);
-                if lfin && (u0 - u0) + (u1 - u1) == 0.0 {
-                    let (xs, ys) = (&mut x[lo..end], &mut y[lo..end]);
-                    match (u0 != 0.0, u1 != 0.0) {
-                        (true, true) => axpy2(simd, xs, ys, l, u0, u1),
-                        (false, false) => {}
-                        (true, false) => axpy(simd, xs, l, u0),
-                        (false, true) => axpy(simd, ys, l, u1),
-                    }
-                } else {
-                    pat.finite = false;
-                    textbook_update(x, lk, k);
-                    textbook_update(y, lk, k);
+                let (x, y) = (&mut x[lo..end], &mut y[lo..end]);
+                match (u0 != 0.0, u1 != 0.0) {
+                    (true, true) => axpy2(simd, x, y, l, u0, u1),
+                    (false, false) => {}
+                    (true, false) => axpy(simd, x, l, u0),
+                    (false, true) => axpy(simd, y, l, u1),
                 }
             }
             let x = pairs.into_remainder();
-            if x.len() == ld {
+            if x.len() == ld && x[k] != 0.0 {
                 let u = x[k];
-                if lfin && u - u == 0.0 {
-                    if u != 0.0 {
-                        axpy(simd, &mut x[lo..end], l, u);
-                    }
-                } else {
-                    pat.finite = false;
-                    textbook_update(x, lk, k);
-                }
+                axpy(simd, &mut x[lo..end], l, u);
             }
         }
+        // U: where its columns start, and whether it is finite (if not, the textbook LU
+        // refuses the matrix: see `mod.rs`).
+        let mut bad = 0;
         for k in 0..n {
             let u = &a[k * ld..k * ld + k];
             pat.top[k] = u.iter().position(|v| *v != 0.0).unwrap_or(k);
+            bad |= u.iter().fold(0, |b, &v| b | non_finite_bits(v));
+        }
+        if bad != 0 {
+            return Err(Singular);
         }
         Ok(())
     }
@@ -158,18 +156,19 @@ impl RealLu {
     #[inline(always)]
     fn solve_kernel<S: Simd>(&self, simd: S, b: &mut [f64]) {
         let (n, ld, a, pat) = (self.n, self.ld, &self.a, &self.pat);
-        // L y = P b, interchanging as the factorisation did. The zeros of L and of b are
-        // skipped only where that is exact: finite factors and a finite b[k].
+        // L y = P b, interchanging as the factorisation did. The factors are finite (or
+        // refused), so b[k] = 0 is skipped exactly; the zeros of L only for finite b[k]
+        // (0·∞ is NaN).
         for k in 0..n {
             b.swap(k, pat.piv[k]);
             let bk = b[k];
-            if pat.finite && bk.is_finite() {
-                if bk != 0.0 {
-                    let (lo, hi) = (pat.lo[k], pat.hi[k]);
-                    axpy(simd, &mut b[lo..hi], &a[k * ld + lo..k * ld + hi], bk);
-                }
-            } else {
-                axpy(simd, &mut b[k + 1..n], &a[k * ld + k + 1..k * ld + n], bk);
+            if bk != 0.0 {
+                let (lo, hi) = if bk.is_finite() {
+                    (pat.lo[k], pat.hi[k])
+                } else {
+                    (k + 1, n)
+                };
+                axpy(simd, &mut b[lo..hi], &a[k * ld + lo..k * ld + hi], bk);
             }
         }
         // U x = y, column-oriented, columns k1 = k0 + 1 and k0 in one pass over the rows
@@ -198,17 +197,5 @@ impl RealLu {
         if k == 1 {
             b[0] /= a[0];
         }
-    }
-}
-
-/// x − l·u on rows k + 1.. of column x (`l` = rows k + 1..n of column k), the textbook's
-/// step for one column. Out of line: inlined, its pointers crowded the registers of the
-/// update loop.
-#[cold]
-#[inline(never)]
-fn textbook_update(x: &mut [f64], l: &[f64], k: usize) {
-    let u = x[k];
-    for (x, &l) in x[k + 1..].iter_mut().zip(l) {
-        *x -= l * u;
     }
 }
