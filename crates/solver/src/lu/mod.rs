@@ -14,10 +14,18 @@
 //!   with a non-zero in row k are updated. No symbolic pattern is needed, so a Jacobian
 //!   whose zeros move costs nothing extra. On the knuckle-boom crane (n = 38) this does
 //!   about half the multiply-adds of a dense LU.
-//! - **One pass over the trailing columns per step**: each column has rows k and p
-//!   interchanged, is tested, and is updated in the same visit, two columns at a time (the
-//!   first of a pair waits for the second), sharing the loads of the L column; row ranges
-//!   widened to a multiple of four rows (over exact zeros).
+//! - **Interchange, then update by adjacent pairs**: rows k and p are interchanged in the
+//!   trailing columns in a pass of their own; then the trailing columns are visited two
+//!   adjacent ones at a time (sharing the loads of the L column), each with u = a[k, j] ≠ 0
+//!   updated. (Before issue 22 one pass did both, pairing each column with the next non-zero
+//!   one; its bookkeeping cost more than the updates on the crane.)
+//! - **Padded columns**: each column has [`PAD`] rows of padding below row n − 1, so that
+//!   the row range of every update, widened to a multiple of four rows, fits and the vector
+//!   loops never fall back to scalar remainders (a third of the complex kernel's update
+//!   instructions before). The rows added hold exact zeros of L, or padding.
+//! - **Slices, bounds asserted once**: the pivot search and the zero scans run over slices,
+//!   and the bounds of the update loops are asserted once per step, so that the loops carry
+//!   no bounds checks.
 //! - **Explicit four-wide vectors** in the updates of factorisations and forward solves
 //!   (pulp's `f64s`): LLVM's own vectorisation ran eight rows per iteration and left the
 //!   last four rows of most columns to a scalar loop (40 % of the real kernel's update
@@ -32,6 +40,19 @@
 //!   Rust never fuses a multiply and an add, so the results are bit-identical either way.
 //! - **Solves** skip the zeros of L and U likewise and back-substitute two U columns per
 //!   pass.
+//!
+//! **NaN and ∞.** Skipping x − l·u for l = 0 or u = 0 is exact only for finite l and u
+//! (0·∞ and NaN·0 are NaN). In the textbook LU a non-finite l or u always ends in a refused
+//! pivot: a non-finite u = a[k, j] makes rows k + 1.. of column j all ∞ or NaN (x − l·u, with
+//! l = 0 giving NaN), so the pivot search of step j finds an infinite size or only NaN; a
+//! non-finite l in row i makes row i ∞ or NaN in every trailing column, which stays so, and
+//! at the step whose diagonal it reaches (NaN never wins a pivot search) the pivot is
+//! refused. Until the first non-finite l or u every skip is exact, so the kernels meet it
+//! exactly when the textbook does, and they refuse the matrix then (L: checked as it is
+//! scaled; U: once at the end, where it is final). So a factorisation either is the
+//! textbook's or is refused as it would be; before issue 22 a u = NaN was skipped, which
+//! could accept a matrix the textbook refuses. The solves skip b[k] = 0 (the factors are
+//! finite) but trim the zero rows of L and U only for finite b[k] and x[k].
 //!
 //! **Bit-identical results.** Every entry receives the same operations in the same order as
 //! in the textbook dense LU with partial pivoting and its forward and back substitution
@@ -72,7 +93,8 @@ pub(crate) use real::RealLu;
 
 use pulp::Simd;
 
-/// The matrix has a zero or non-finite pivot.
+/// The matrix has a zero or non-finite pivot, or (which leads there in the textbook LU) a
+/// non-finite entry of L or U.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Singular;
 

@@ -180,3 +180,47 @@ fn non_finite_entries_match_the_reference() {
         }
     }
 }
+
+/// Non-finite values exactly where the kernels skip: an ∞ or NaN u above an empty L column
+/// (the textbook spreads NaN = 0·∞ down its column and refuses the matrix; skipping would
+/// not), and ∞ or NaN right-hand side entries over zero rows of L and U (0·∞ is NaN in the
+/// textbook's solution).
+#[test]
+fn non_finite_values_over_skipped_zeros_match_the_reference() {
+    let n = 9;
+    for v in [f64::INFINITY, f64::NEG_INFINITY, f64::NAN] {
+        for (i, j) in [(0, 1), (0, 8), (3, 5), (7, 8), (2, 4)] {
+            // diag·I − J upper triangular but for one coupling below, with v at (i, j).
+            let mut jac = vec![0.0; n * n];
+            jac[j * n + i] = v;
+            jac[2 * n + 6] = 0.5;
+            for arch in [Arch::new(), Arch::Scalar] {
+                check_against_reference(n, &jac, Complex::new(1.0, 0.5), arch);
+                check_against_reference(n, &jac, Complex::new(2.0, 0.0), arch);
+            }
+            let mut lu = RealLu::new(n);
+            lu.set_shifted(1.0, &jac);
+            assert!(lu.factor().is_err(), "({i}, {j}) = {v} must be refused");
+        }
+    }
+    // Sparse finite matrices, a non-finite b at each position in turn.
+    for (s, density) in [0.1, 0.3].into_iter().enumerate() {
+        let n = 12;
+        let mut rnd = stream(900 + s as u64);
+        let jac: Vec<f64> = (0..n * n)
+            .map(|_| if rnd().abs() < density { rnd() } else { 0.0 })
+            .collect();
+        for v in [f64::INFINITY, f64::NAN] {
+            for at in 0..n {
+                let mut b: Vec<f64> = (0..n)
+                    .map(|i| if i % 4 == 1 { 0.0 } else { rnd() })
+                    .collect();
+                b[at] = v;
+                for arch in [Arch::new(), Arch::Scalar] {
+                    check_with_rhs(n, &jac, Complex::new(3.0, 1.0), arch, &b);
+                    check_with_rhs(n, &jac, Complex::new(3.0, 0.0), arch, &b);
+                }
+            }
+        }
+    }
+}
