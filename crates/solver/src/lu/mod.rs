@@ -266,9 +266,8 @@ fn lane_max(chunks: impl Iterator<Item = [f64; 4]>, rest: impl Iterator<Item = f
 #[inline(always)]
 fn pivot(best: f64, mut sizes: impl Iterator<Item = f64> + Clone) -> Option<usize> {
     let first = sizes.clone().next()?;
-    // (best < ∞ rather than is_finite(): best is not NaN, and two comparisons are cheaper.)
-    #[allow(clippy::float_cmp)]
-    if best > 0.0 && best < f64::INFINITY && first == first {
+    // (best < ∞ rather than is_finite(): best is not NaN.)
+    if best > 0.0 && best < f64::INFINITY && !first.is_nan() {
         // Exact: best is one of the sizes.
         #[allow(clippy::float_cmp)]
         sizes.position(|s| s == best)
@@ -326,6 +325,8 @@ fn nonzero_rows(
 /// column (integer OR, so that it vectorises) it tells whether the whole column is finite.
 #[inline(always)]
 fn non_finite_bits(v: f64) -> u64 {
+    // v − v is +0 for every finite v (also −0), NaN otherwise.
+    #[allow(clippy::eq_op)]
     (v - v).to_bits()
 }
 
