@@ -14,10 +14,18 @@
 //!   with a non-zero in row k are updated. No symbolic pattern is needed, so a Jacobian
 //!   whose zeros move costs nothing extra. On the knuckle-boom crane (n = 38) this does
 //!   about half the multiply-adds of a dense LU.
-//! - **One pass over the trailing columns per step**: each column has rows k and p
-//!   interchanged, is tested, and is updated in the same visit, two columns at a time (the
-//!   first of a pair waits for the second), sharing the loads of the L column; row ranges
-//!   widened to a multiple of four rows (over exact zeros).
+//! - **Interchange, then update by adjacent pairs**: rows k and p are interchanged in the
+//!   trailing columns in a pass of their own; then the trailing columns are visited two
+//!   adjacent ones at a time (sharing the loads of the L column), each with u = a[k, j] ≠ 0
+//!   updated. (Before issue 22 one pass did both, pairing each column with the next non-zero
+//!   one; its bookkeeping cost more than the updates on the crane.)
+//! - **Padded columns**: each column has [`PAD`] rows of padding below row n − 1, so that
+//!   the row range of every update, widened to a multiple of four rows, fits and the vector
+//!   loops never fall back to scalar remainders (a third of the complex kernel's update
+//!   instructions before). The rows added hold exact zeros of L, or padding.
+//! - **Slices, bounds asserted once**: the pivot search and the zero scans run over slices,
+//!   and the bounds of the update loops are asserted once per step, so that the loops carry
+//!   no bounds checks.
 //! - **Explicit four-wide vectors** in the updates of factorisations and forward solves
 //!   (pulp's `f64s`): LLVM's own vectorisation ran eight rows per iteration and left the
 //!   last four rows of most columns to a scalar loop (40 % of the real kernel's update
@@ -32,6 +40,19 @@
 //!   Rust never fuses a multiply and an add, so the results are bit-identical either way.
 //! - **Solves** skip the zeros of L and U likewise and back-substitute two U columns per
 //!   pass.
+//!
+//! **NaN and ∞.** Skipping x − l·u for l = 0 or u = 0 is exact only for finite l and u
+//! (0·∞ and NaN·0 are NaN). In the textbook LU a non-finite l or u always ends in a refused
+//! pivot: a non-finite u = a[k, j] makes rows k + 1.. of column j all ∞ or NaN (x − l·u, with
+//! l = 0 giving NaN), so the pivot search of step j finds an infinite size or only NaN; a
+//! non-finite l in row i makes row i ∞ or NaN in every trailing column, which stays so, and
+//! at the step whose diagonal it reaches (NaN never wins a pivot search) the pivot is
+//! refused. Until the first non-finite l or u every skip is exact, so the kernels meet it
+//! exactly when the textbook does, and they refuse the matrix then (L: checked as it is
+//! scaled; U: once at the end, where it is final). So a factorisation either is the
+//! textbook's or is refused as it would be; before issue 22 a u = NaN was skipped, which
+//! could accept a matrix the textbook refuses. The solves skip b[k] = 0 (the factors are
+//! finite) but trim the zero rows of L and U only for finite b[k] and x[k].
 //!
 //! **Bit-identical results.** Every entry receives the same operations in the same order as
 //! in the textbook dense LU with partial pivoting and its forward and back substitution
@@ -72,7 +93,8 @@ pub(crate) use real::RealLu;
 
 use pulp::Simd;
 
-/// The matrix has a zero or non-finite pivot.
+/// The matrix has a zero or non-finite pivot, or (which leads there in the textbook LU) a
+/// non-finite entry of L or U.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Singular;
 
@@ -221,47 +243,91 @@ fn caxpy_twice(
     }
 }
 
-/// The pivot of partial pivoting among `size(0..len)`: the first of the largest, which is
-/// what a scan keeping the first of equal sizes finds. `None` if that size is zero or not
-/// finite, or if entry 0 is NaN (such a scan starts from it and never replaces it).
-///
-/// The maximum is taken in four independent lanes so that it vectorises; it is exact, so
-/// the lane order does not matter.
+/// The largest of four lanes of sizes and a remainder (NaN sizes never win: `s > m` is
+/// false). Exact, so the lane order does not matter; four lanes so that it vectorises.
 #[inline(always)]
-fn pivot(len: usize, size: impl Fn(usize) -> f64) -> Option<usize> {
+fn lane_max(chunks: impl Iterator<Item = [f64; 4]>, rest: impl Iterator<Item = f64>) -> f64 {
     let mut m = [0.0f64; 4];
-    let full = len / 4 * 4;
-    for c in (0..full).step_by(4) {
-        for (w, mw) in m.iter_mut().enumerate() {
-            let s = size(c + w);
+    for c in chunks {
+        for (mw, s) in m.iter_mut().zip(c) {
             *mw = if s > *mw { s } else { *mw };
         }
     }
-    for i in full..len {
-        let s = size(i);
+    for s in rest {
         m[0] = if s > m[0] { s } else { m[0] };
     }
-    let best = m[0].max(m[1]).max(m[2].max(m[3]));
-    if best > 0.0 && best.is_finite() && !size(0).is_nan() {
+    m[0].max(m[1]).max(m[2].max(m[3]))
+}
+
+/// The pivot of partial pivoting among `sizes`, whose largest is `best`: the first of the
+/// largest, which is what a scan keeping the first of equal sizes finds. `None` if that size
+/// is zero or not finite, or if entry 0 is NaN (such a scan starts from it and never
+/// replaces it).
+#[inline(always)]
+fn pivot(best: f64, mut sizes: impl Iterator<Item = f64> + Clone) -> Option<usize> {
+    let first = sizes.clone().next()?;
+    // (best < ∞ rather than is_finite(): best is not NaN.)
+    if best > 0.0 && best < f64::INFINITY && !first.is_nan() {
         // Exact: best is one of the sizes.
         #[allow(clippy::float_cmp)]
-        (0..len).position(|i| size(i) == best)
+        sizes.position(|s| s == best)
     } else {
         None
     }
 }
 
-/// The rows lo..hi of first..n outside which `nonzero` is false (lo = hi = n if it is false
-/// everywhere).
+/// The pivot of a real column, sizes |a| (see [`pivot`]); slices, so no bounds checks.
 #[inline(always)]
-fn nonzero_rows(first: usize, n: usize, nonzero: impl Fn(usize) -> bool) -> (usize, usize) {
-    match (first..n).position(&nonzero) {
-        None => (n, n),
-        Some(lo) => {
-            let hi = (first..n).rposition(&nonzero).map_or(n, |i| first + i + 1);
-            (first + lo, hi)
-        }
+fn pivot_real(col: &[f64]) -> Option<usize> {
+    let chunks = col.chunks_exact(4);
+    let rest = chunks.remainder().iter().map(|v| v.abs());
+    let best = lane_max(
+        chunks.map(|c| [c[0].abs(), c[1].abs(), c[2].abs(), c[3].abs()]),
+        rest,
+    );
+    pivot(best, col.iter().map(|v| v.abs()))
+}
+
+/// The pivot of a complex column on planes, sizes |re| + |im| as LAPACK's (see [`pivot`]).
+#[inline(always)]
+fn pivot_complex(re: &[f64], im: &[f64]) -> Option<usize> {
+    let im = &im[..re.len()];
+    let size = |(r, i): (&f64, &f64)| r.abs() + i.abs();
+    let (cr, ci) = (re.chunks_exact(4), im.chunks_exact(4));
+    let rest = cr.remainder().iter().zip(ci.remainder()).map(size);
+    let chunks = cr.zip(ci).map(|(r, i)| {
+        [
+            r[0].abs() + i[0].abs(),
+            r[1].abs() + i[1].abs(),
+            r[2].abs() + i[2].abs(),
+            r[3].abs() + i[3].abs(),
+        ]
+    });
+    pivot(lane_max(chunks, rest), re.iter().zip(im).map(size))
+}
+
+/// The rows lo..hi of first.. outside which a column is zero, from the first and last
+/// non-zero's positions relative to first (lo = hi = end if there is none).
+#[inline(always)]
+fn nonzero_rows(
+    first: usize,
+    end: usize,
+    pos: Option<usize>,
+    rpos: Option<usize>,
+) -> (usize, usize) {
+    match (pos, rpos) {
+        (Some(lo), Some(hi)) => (first + lo, first + hi + 1),
+        _ => (end, end),
     }
+}
+
+/// `bits(v − v)`: zero if v is finite, not zero if it is infinite or NaN; OR-ed over a
+/// column (integer OR, so that it vectorises) it tells whether the whole column is finite.
+#[inline(always)]
+fn non_finite_bits(v: f64) -> u64 {
+    // v − v is +0 for every finite v (also −0), NaN otherwise.
+    #[allow(clippy::eq_op)]
+    (v - v).to_bits()
 }
 
 /// Rows lo..hi widened, within first..end, to a multiple of 4 rows where there is room, so
@@ -295,4 +361,17 @@ impl Pattern {
             top: vec![0; n],
         }
     }
+}
+
+/// Rows of padding below each column of the factors: every update then runs over a
+/// multiple of four rows, [`padded_end`] reaching at most 3 rows below row n − 1. The
+/// padding rows of L stay zero (they are never scaled), so that the trailing columns'
+/// padding rows only ever receive x − 0·u; they are never read as results.
+const PAD: usize = 3;
+
+/// The end of rows lo..hi extended to a multiple of four rows (into zero rows of L, or the
+/// padding).
+#[inline(always)]
+fn padded_end(lo: usize, hi: usize) -> usize {
+    lo + (hi - lo).div_ceil(4) * 4
 }

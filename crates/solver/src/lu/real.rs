@@ -2,12 +2,17 @@
 
 use pulp::{Arch, Simd, WithSimd};
 
-use super::{axpy, axpy2, axpy_twice, nonzero_rows, pivot, widen, Pattern, Singular};
+use super::{
+    axpy, axpy2, axpy_twice, non_finite_bits, nonzero_rows, padded_end, pivot_real, widen, Pattern,
+    Singular, PAD,
+};
 
 /// A real n×n matrix and, after [`RealLu::factor`], its factors P·A = L·U in place.
 #[derive(Clone, Debug)]
 pub(crate) struct RealLu {
     pub(super) n: usize,
+    /// Column stride: n rows and [`PAD`] rows of padding.
+    pub(super) ld: usize,
     /// Column-major; L below the diagonal (unit diagonal implied), U on and above it.
     pub(super) a: Vec<f64>,
     pub(super) pat: Pattern,
@@ -21,9 +26,11 @@ impl RealLu {
 
     /// With a given instruction set (the tests compare them).
     pub(super) fn with_arch(n: usize, arch: Arch) -> Self {
+        let ld = n + PAD;
         Self {
             n,
-            a: vec![0.0; n * n],
+            ld,
+            a: vec![0.0; ld * n],
             pat: Pattern::new(n),
             arch,
         }
@@ -31,11 +38,13 @@ impl RealLu {
 
     /// Set the matrix to `diag·I − J` (J column-major), ready for [`Self::factor`].
     pub(crate) fn set_shifted(&mut self, diag: f64, jac: &[f64]) {
-        for (dst, &j) in self.a.iter_mut().zip(jac) {
-            *dst = -j;
-        }
-        for k in 0..self.n {
-            self.a[k * self.n + k] += diag;
+        let (n, ld) = (self.n, self.ld);
+        for k in 0..n {
+            let (dst, src) = (&mut self.a[k * ld..k * ld + n], &jac[k * n..k * n + n]);
+            for (d, &j) in dst.iter_mut().zip(src) {
+                *d = -j;
+            }
+            dst[k] += diag;
         }
     }
 
@@ -54,57 +63,79 @@ impl RealLu {
 
     #[inline(always)]
     fn factor_kernel<S: Simd>(&mut self, simd: S) -> Result<(), Singular> {
-        let n = self.n;
-        let pat = &mut self.pat;
+        let (n, ld) = (self.n, self.ld);
+        let Self { a, pat, .. } = self;
         for k in 0..n {
-            let (left, right) = self.a.split_at_mut((k + 1) * n);
-            let colk = &mut left[k * n..];
-            let p = k + pivot(n - k, |i| colk[k + i].abs()).ok_or(Singular)?;
+            let (left, right) = a.split_at_mut((k + 1) * ld);
+            let colk = &mut left[k * ld..];
+            let p = k + pivot_real(&colk[k..n]).ok_or(Singular)?;
             pat.piv[k] = p;
             colk.swap(k, p);
             let inv = 1.0 / colk[k];
-            for v in &mut colk[k + 1..] {
+            // l = a·(1/pivot). A non-finite l: the textbook LU refuses the matrix (see
+            // `mod.rs`), so does this one, before skipping anything.
+            let mut bad = 0;
+            for v in &mut colk[k + 1..n] {
                 *v *= inv;
+                bad |= non_finite_bits(*v);
             }
-            let (lo, hi) = nonzero_rows(k + 1, n, |i| colk[i] != 0.0);
+            if bad != 0 {
+                return Err(Singular);
+            }
+            let l = &colk[k + 1..n];
+            let (pos, rpos) = (
+                l.iter().position(|v| *v != 0.0),
+                l.iter().rposition(|v| *v != 0.0),
+            );
+            let (lo, hi) = nonzero_rows(k + 1, n, pos, rpos);
             let (lo, hi) = widen(lo, hi, k + 1, n);
             pat.lo[k] = lo;
             pat.hi[k] = hi;
-            if lo == hi {
-                if p != k {
-                    for colj in right.chunks_exact_mut(n) {
-                        colj.swap(k, p);
-                    }
+            let end = padded_end(lo, hi);
+            // Known to the compiler, these bounds leave the loops below without bounds
+            // checks.
+            assert!(k < ld && p < ld && lo <= end && end <= ld);
+            // Rows k and p interchanged in the trailing columns (LINPACK's layout).
+            if p != k {
+                for x in right.chunks_exact_mut(ld) {
+                    x.swap(k, p);
                 }
+            }
+            if lo == hi {
                 continue;
             }
-            // One pass over the trailing columns: rows k and p interchanged, and those with
-            // a non-zero (not NaN) in row k updated, two at a time (the first of a pair
-            // waits in `pending`).
-            let l = &colk[lo..hi];
-            let mut pending: Option<&mut [f64]> = None;
-            for colj in right.chunks_exact_mut(n) {
-                if p != k {
-                    colj.swap(k, p);
-                }
-                if colj[k].abs() > 0.0 {
-                    match pending.take() {
-                        None => pending = Some(colj),
-                        Some(x) => {
-                            let (a, b) = (x[k], colj[k]);
-                            axpy2(simd, &mut x[lo..hi], &mut colj[lo..hi], l, a, b);
-                        }
-                    }
+            // The trailing columns, two adjacent ones at a time (sharing the loads of l),
+            // those with u = a[k, j] ≠ 0 updated over the non-zero rows of l widened to a
+            // multiple of four (zero rows of l or padding).
+            let l = &colk[lo..end];
+            let mut pairs = right.chunks_exact_mut(2 * ld);
+            for pair in &mut pairs {
+                let (x, y) = pair.split_at_mut(ld);
+                let (u0, u1) = (x[k], y[k]);
+                let (x, y) = (&mut x[lo..end], &mut y[lo..end]);
+                match (u0 != 0.0, u1 != 0.0) {
+                    (true, true) => axpy2(simd, x, y, l, u0, u1),
+                    (false, false) => {}
+                    (true, false) => axpy(simd, x, l, u0),
+                    (false, true) => axpy(simd, y, l, u1),
                 }
             }
-            if let Some(x) = pending {
-                let a = x[k];
-                axpy(simd, &mut x[lo..hi], l, a);
+            let x = pairs.into_remainder();
+            if x.len() == ld && x[k] != 0.0 {
+                let u = x[k];
+                axpy(simd, &mut x[lo..end], l, u);
             }
         }
+        // U: where its columns start, and whether it is finite (if not, the textbook LU
+        // refuses the matrix: see `mod.rs`).
+        let mut bad = 0;
         for k in 0..n {
-            let u = &self.a[k * n..k * n + k];
+            let u = &a[k * ld..k * ld + k];
             pat.top[k] = u.iter().position(|v| *v != 0.0).unwrap_or(k);
+            bad |= u.iter().fold(0, |b, &v| b | non_finite_bits(v));
+        }
+        if bad != 0 {
+            return Err(Singular);
         }
         Ok(())
     }
@@ -124,28 +155,42 @@ impl RealLu {
 
     #[inline(always)]
     fn solve_kernel<S: Simd>(&self, simd: S, b: &mut [f64]) {
-        let (n, a, pat) = (self.n, &self.a, &self.pat);
-        // L y = P b, interchanging as the factorisation did.
+        let (n, ld, a, pat) = (self.n, self.ld, &self.a, &self.pat);
+        // L y = P b, interchanging as the factorisation did. The factors are finite (or
+        // refused), so b[k] = 0 is skipped exactly; the zeros of L only for finite b[k]
+        // (0·∞ is NaN).
         for k in 0..n {
             b.swap(k, pat.piv[k]);
             let bk = b[k];
             if bk != 0.0 {
-                let (lo, hi) = (pat.lo[k], pat.hi[k]);
-                axpy(simd, &mut b[lo..hi], &a[k * n + lo..k * n + hi], bk);
+                let (lo, hi) = if bk.is_finite() {
+                    (pat.lo[k], pat.hi[k])
+                } else {
+                    (k + 1, n)
+                };
+                axpy(simd, &mut b[lo..hi], &a[k * ld + lo..k * ld + hi], bk);
             }
         }
         // U x = y, column-oriented, columns k1 = k0 + 1 and k0 in one pass over the rows
-        // above k0 (each row still receives k1's term first).
+        // above k0 (each row still receives k1's term first); the zeros of U above top are
+        // skipped for finite x only.
         let mut k = n;
         while k >= 2 {
             let (k1, k0) = (k - 1, k - 2);
-            b[k1] /= a[k1 * n + k1];
+            b[k1] /= a[k1 * ld + k1];
             let x1 = b[k1];
-            b[k0] -= a[k1 * n + k0] * x1;
-            b[k0] /= a[k0 * n + k0];
+            b[k0] -= a[k1 * ld + k0] * x1;
+            b[k0] /= a[k0 * ld + k0];
             let x0 = b[k0];
-            let top = widen(pat.top[k1].min(pat.top[k0]), k0, 0, k0).0;
-            let (u1, u0) = (&a[k1 * n + top..k1 * n + k0], &a[k0 * n + top..k0 * n + k0]);
+            let top = if x1.is_finite() && x0.is_finite() {
+                widen(pat.top[k1].min(pat.top[k0]), k0, 0, k0).0
+            } else {
+                0
+            };
+            let (u1, u0) = (
+                &a[k1 * ld + top..k1 * ld + k0],
+                &a[k0 * ld + top..k0 * ld + k0],
+            );
             axpy_twice(&mut b[top..k0], u1, x1, u0, x0);
             k -= 2;
         }
