@@ -15,6 +15,8 @@ use std::ops::Range;
 use crate::element::{Element, Io, Layout, Slot, Source};
 use crate::local_jacobian::{LocalJacobian, LocalShape, DENSE_MAX_COLS, DENSE_MAX_ENTRIES};
 
+use super::constant::{constant_partials, Constant};
+
 use super::super::StateEquations;
 
 /// A gradient's place: values `g[start..start + len]` of the work, and the state (column)
@@ -128,6 +130,9 @@ pub(super) struct BlockCode {
     pub(super) entries: Option<Entries>,
     /// The local difference, if it gives none (always for a dense block).
     pub(super) diffs: Option<Differences>,
+    /// The nonzero partials in storage order, if the element's partials are constant
+    /// ([`Element::partials_are_constant`]): the pass then neither asks for nor scans them.
+    pub(super) constant: Option<Vec<Constant>>,
 }
 
 /// The compiled Jacobian of one order of the plan.
@@ -554,6 +559,10 @@ impl StateEquations {
                     first,
                 }
             });
+            let constant = entries
+                .as_ref()
+                .filter(|_| element.partials_are_constant())
+                .and_then(|e| constant_partials(element, target, &io, &shape, e));
             // What the block wrote now has its gradient.
             for (r, &(cell, _)) in rows.iter().enumerate() {
                 if let Cell::Derivative(i) = cell {
@@ -577,6 +586,7 @@ impl StateEquations {
                 out,
                 entries,
                 diffs,
+                constant,
             });
         }
         c.no_structure = vec![0; c.max_rows + 1];

@@ -48,7 +48,8 @@ impl Work {
     }
 }
 
-/// `g[d..d + len] += c · g[s..s + len]` for every run.
+/// `g[d..d + len] += c · g[s..s + len]` for every run (for c = ±1 an add or a subtract:
+/// the same bits, one multiply less).
 #[inline]
 fn apply(g: &mut [f64], runs: &[Run], c: f64) {
     for run in runs {
@@ -60,8 +61,19 @@ fn apply(g: &mut [f64], runs: &[Run], c: f64) {
             continue;
         }
         let (src, dst) = g.split_at_mut(d);
-        for (a, b) in dst[..len].iter_mut().zip(&src[s..s + len]) {
-            *a += c * b;
+        let (dst, src) = (&mut dst[..len], &src[s..s + len]);
+        if c == 1.0 {
+            for (a, b) in dst.iter_mut().zip(src) {
+                *a += b;
+            }
+        } else if c == -1.0 {
+            for (a, b) in dst.iter_mut().zip(src) {
+                *a -= b;
+            }
+        } else {
+            for (a, b) in dst.iter_mut().zip(src) {
+                *a += c * b;
+            }
         }
     }
 }
@@ -213,9 +225,20 @@ impl<'a> Pass<'a> {
     fn block(&mut self, b: &BlockCode) {
         self.eval(b.id, b.target);
         self.w.g[b.out.range()].fill(0.0);
-        let gives = self.partials(b);
         let code = self.code;
         let updates = &code.updates;
+        if let Some(constant) = &b.constant {
+            // the partials compiled once, nonzero ones in storage order
+            for k in constant {
+                apply(
+                    &mut self.w.g,
+                    &updates[k.first as usize..k.end as usize],
+                    k.c,
+                );
+            }
+            return;
+        }
+        let gives = self.partials(b);
         let w = &mut *self.w;
         if let Some(e) = &b.entries {
             // Entry by entry in storage order (row by row, columns ascending), each value
