@@ -15,7 +15,7 @@ use std::ops::Range;
 use crate::element::{Element, Io, Layout, Slot, Source};
 use crate::local_jacobian::{LocalJacobian, LocalShape, DENSE_MAX_COLS, DENSE_MAX_ENTRIES};
 
-use super::constant::{constant_partials, Constant};
+use super::constant::{aliases, constant_partials, Constant};
 
 use super::super::StateEquations;
 
@@ -52,7 +52,7 @@ pub(super) struct Src {
 }
 
 impl Src {
-    const NONE: Self = Self {
+    pub(super) const NONE: Self = Self {
         span: Span::EMPTY,
         scale: 1.0,
     };
@@ -145,8 +145,9 @@ pub(in crate::equations) struct Compiled {
     pub(super) blocks: Vec<BlockCode>,
     /// The runs of every entry, block after block.
     pub(super) updates: Vec<Run>,
-    /// Each effort, flow and signal scalar's gradient after the pass.
-    pub(super) slots: Vec<Span>,
+    /// Each effort, flow and signal scalar's gradient after the pass, and the factor (±1)
+    /// from it to the scalar (a row that aliases another scalar's gradient).
+    pub(super) slots: Vec<Src>,
     /// The Jacobian's rows: state index and gradient.
     pub(super) rows: Vec<(usize, Span)>,
     pub(super) max_entries: usize,
@@ -195,16 +196,18 @@ fn union(cols: &[u32], srcs: impl Iterator<Item = Src>) -> Vec<u32> {
 
 impl StateEquations {
     /// The gradient of a cell as compiled so far.
-    fn src_of(&self, slots: &[Span], cell: Cell) -> Src {
+    fn src_of(&self, slots: &[Src], cell: Cell) -> Src {
         let nb = self.n_bond_values;
-        let span = match cell {
+        match cell {
             Cell::Effort(o) => slots[o],
             Cell::Flow(o) => slots[nb + o],
             Cell::Signal(o) => slots[2 * nb + o],
-            Cell::State(i) => Span::unit(i),
-            Cell::Derivative(_) => Span::EMPTY,
-        };
-        Src { span, scale: 1.0 }
+            Cell::State(i) => Src {
+                span: Span::unit(i),
+                scale: 1.0,
+            },
+            Cell::Derivative(_) => Src::NONE,
+        }
     }
 
     /// The slot index of a stored effort, flow or signal cell.
@@ -231,14 +234,17 @@ impl StateEquations {
     }
 
     /// The gradient of every local column of element `id`, in column order.
-    fn column_srcs(&self, id: usize, slots: &[Span]) -> Vec<Src> {
+    fn column_srcs(&self, id: usize, slots: &[Src]) -> Vec<Src> {
         let l = &self.layouts[id];
         let mut srcs = Vec::new();
         for p in &l.ports {
             srcs.extend((0..p.dim).map(|k| self.src_of(slots, Cell::Effort(p.offset + k))));
-            srcs.extend((0..p.dim).map(|k| Src {
-                scale: p.sign,
-                ..self.src_of(slots, Cell::Flow(p.offset + k))
+            srcs.extend((0..p.dim).map(|k| {
+                let s = self.src_of(slots, Cell::Flow(p.offset + k));
+                Src {
+                    scale: p.sign * s.scale,
+                    ..s
+                }
             }));
         }
         for i in 0..l.inputs.len() {
@@ -353,7 +359,7 @@ impl StateEquations {
             cols: (0..width as u32).collect(),
             blocks: Vec::new(),
             updates: Vec::new(),
-            slots: vec![Span::EMPTY; n_slots],
+            slots: vec![Src::NONE; n_slots],
             rows: Vec::new(),
             max_entries: 0,
             max_rows: 0,
@@ -445,7 +451,7 @@ impl StateEquations {
                 (true, true, None)
             };
             // The pattern of each row.
-            let patterns: Vec<Vec<u32>> = match &structure {
+            let mut patterns: Vec<Vec<u32>> = match &structure {
                 Some((row_ptr, cols)) if !with_diffs => (0..m)
                     .map(|r| {
                         let (a, e) = (row_ptr[r] as usize, row_ptr[r + 1] as usize);
@@ -466,6 +472,18 @@ impl StateEquations {
                     vec![all; m]
                 }
             };
+            // A row that is ±1 times one column of the same pattern (a junction's shared
+            // effort or flow) is that column's gradient: no place or updates of its own.
+            let alias = if structure.is_some() && !with_diffs && element.partials_are_constant() {
+                aliases(element, target, &io, &shape, &rows, &col_srcs, &patterns)
+            } else {
+                vec![None; m]
+            };
+            for (p, a) in patterns.iter_mut().zip(&alias) {
+                if a.is_some() {
+                    p.clear();
+                }
+            }
             let start = c.cols.len();
             let mut row_spans = Vec::with_capacity(m);
             for p in &patterns {
@@ -568,10 +586,16 @@ impl StateEquations {
                 if let Cell::Derivative(i) = cell {
                     c.rows.push((i, row_spans[r]));
                 } else if let Some(g) = self.slot_of(cell) {
-                    c.slots[g] = row_spans[r];
+                    c.slots[g] = alias[r].unwrap_or(Src {
+                        span: row_spans[r],
+                        scale: 1.0,
+                    });
                     if let Cell::Signal(o) = cell {
                         if let Some(s) = seeds.iter().position(|&s| s == o) {
-                            c.slots[g] = Span::unit(n + s);
+                            c.slots[g] = Src {
+                                span: Span::unit(n + s),
+                                scale: 1.0,
+                            };
                         }
                     }
                 }

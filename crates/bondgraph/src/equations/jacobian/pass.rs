@@ -48,9 +48,8 @@ impl Work {
     }
 }
 
-/// `g[d..d + len] += c · g[s..s + len]` for every run (for c = ±1 an add or a subtract:
-/// the same bits, one multiply less).
-#[inline]
+/// `g[d..d + len] += c · g[s..s + len]` for every run.
+#[inline(always)]
 fn apply(g: &mut [f64], runs: &[Run], c: f64) {
     for run in runs {
         let (d, s, len) = (run.d as usize, run.s as usize, run.len as usize);
@@ -61,19 +60,8 @@ fn apply(g: &mut [f64], runs: &[Run], c: f64) {
             continue;
         }
         let (src, dst) = g.split_at_mut(d);
-        let (dst, src) = (&mut dst[..len], &src[s..s + len]);
-        if c == 1.0 {
-            for (a, b) in dst.iter_mut().zip(src) {
-                *a += b;
-            }
-        } else if c == -1.0 {
-            for (a, b) in dst.iter_mut().zip(src) {
-                *a -= b;
-            }
-        } else {
-            for (a, b) in dst.iter_mut().zip(src) {
-                *a += c * b;
-            }
+        for (a, b) in dst[..len].iter_mut().zip(&src[s..s + len]) {
+            *a += c * b;
         }
     }
 }
