@@ -97,7 +97,9 @@ pub(super) fn aliases(
         let src = col_srcs[col];
         // the factor as the updates would apply it: value · (row factor · column factor)
         let c = v * (rows[r].1 * src.scale);
-        if (c == 1.0 || c == -1.0) && patterns[r].len() == src.span.len as usize {
+        // exactly ±1: only then is the product the column's gradient bit for bit
+        let unit = c.abs().to_bits() == 1.0_f64.to_bits();
+        if unit && patterns[r].len() == src.span.len as usize {
             *a = Some(Src {
                 span: src.span,
                 scale: c,
@@ -105,4 +107,74 @@ pub(super) fn aliases(
         }
     }
     alias
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)] // a fixed, valid test model
+    use nalgebra::DMatrix;
+
+    use super::Src;
+    use crate::{assign_causality, BondGraph, Capacitor, Resistor, StateEquations, ZeroJunction};
+
+    /// A capacitor `c` discharging through `n` resistors `r_k = k + 1` on one 0-junction
+    /// (2·(n + 1) local columns: a wide block for n ≥ 16).
+    fn discharge(c: f64, n: usize) -> StateEquations {
+        let mut g = BondGraph::new();
+        g.add("cap", Capacitor::new(c, 1.0).unwrap()).unwrap();
+        g.add("node", ZeroJunction).unwrap();
+        g.connect_names("node", "cap").unwrap();
+        for k in 0..n {
+            let name = format!("r{k}");
+            g.add(&name, Resistor::new(k as f64 + 1.0).unwrap())
+                .unwrap();
+            g.connect_names("node", &name).unwrap();
+        }
+        StateEquations::new(assign_causality(g).unwrap()).unwrap()
+    }
+
+    /// The junction's stages are compiled once, its shared efforts alias the capacitor's
+    /// gradient, and the Jacobian and every probe's gradient are still right:
+    /// dq/dt = −Σₖ q/(c·rₖ), and each resistor's effort q/c.
+    #[test]
+    fn junction_shares_alias_and_constant_blocks_keep_the_jacobian() {
+        let (c, n) = (0.5, 20);
+        let eqs = discharge(c, n);
+        let mut jac = DMatrix::zeros(0, 0);
+        eqs.jacobian(0.0, &[0.8], &mut jac);
+        let exact: f64 = -(0..n).map(|k| 1.0 / (c * (k as f64 + 1.0))).sum::<f64>();
+        assert!(
+            (jac[(0, 0)] - exact).abs() <= 1e-14 * exact.abs(),
+            "{} vs {exact}",
+            jac[(0, 0)]
+        );
+        {
+            let compiled = eqs.compiled();
+            let code = &compiled.0;
+            let constant = code.blocks.iter().filter(|b| b.constant.is_some()).count();
+            // junction stages, capacitor and resistors: every block but none
+            assert_eq!(constant, code.blocks.len(), "constant blocks");
+            // the n resistor efforts share the capacitor's effort gradient (one place)
+            let shared = |s: &Src| {
+                let same = code.slots.iter().filter(|o| o.span == s.span);
+                same.count()
+            };
+            let most = code.slots.iter().map(shared).max().unwrap();
+            assert_eq!(most, n + 1, "slots on one gradient");
+        }
+        // every probe against differences (the aliased efforts included)
+        let names = eqs.probe_names();
+        let probes: Vec<_> = names.iter().map(|p| eqs.probe(p).unwrap()).collect();
+        let (mut a, mut out) = (DMatrix::zeros(0, 0), DMatrix::zeros(0, 0));
+        eqs.output_jacobian(0.0, &[0.8], &probes, &mut a, &mut out);
+        for (k, name) in names.iter().enumerate() {
+            let read = |q: f64| {
+                eqs.evaluate(0.0, &[q]);
+                eqs.read(probes[k], 0.0, &[q])
+            };
+            let fd = (read(0.8 + 1e-6) - read(0.8 - 1e-6)) / 2e-6;
+            let err = (out[(k, 0)] - fd).abs() / fd.abs().max(1.0);
+            assert!(err < 1e-7, "{name}: {} vs {fd}", out[(k, 0)]);
+        }
+    }
 }
