@@ -18,6 +18,7 @@
 //!
 //! - `compile`: the plan of updates, gradient patterns, local-block structures.
 //! - `constant`: the partials of elements that say they are constant, asked for once.
+//! - `layout`: a block's shape, rows and cells before it is compiled.
 //! - `pass`: one pass of the plan carrying gradients, local differences.
 //! - `sparse`: the sparsity pattern and the sparse target.
 //! - `outputs`: ∂y/∂x and ∂y/∂u of any probe (linearisation).
@@ -29,6 +30,7 @@ use nalgebra::DMatrix;
 
 mod compile;
 mod constant;
+mod layout;
 mod outputs;
 mod pass;
 mod sparse;

@@ -12,10 +12,11 @@
 
 use std::ops::Range;
 
-use crate::element::{Element, Io, Layout, Slot, Source};
+use crate::element::{Element, Io, Layout, Source};
 use crate::local_jacobian::{LocalJacobian, LocalShape, DENSE_MAX_COLS, DENSE_MAX_ENTRIES};
 
 use super::constant::{aliases, constant_partials, Constant};
+use super::layout::BlockLayout;
 
 use super::super::StateEquations;
 
@@ -156,15 +157,6 @@ pub(in crate::equations) struct Compiled {
     pub(super) no_structure: Vec<u32>,
 }
 
-/// A block before compiling: its shape, rows (cell, factor), the columns it writes and the
-/// cells a local difference reads.
-struct BlockLayout {
-    shape: LocalShape,
-    rows: Vec<(Cell, f64)>,
-    written: Vec<usize>,
-    cells: Vec<Cell>,
-}
-
 impl Entries {
     /// The (row, column) of every entry a wide block may set (in a plan compiled before).
     fn structure(&self, n_cols: usize) -> Vec<(u32, u32)> {
@@ -222,7 +214,7 @@ impl StateEquations {
     }
 
     /// The cells of signal input `i` of an element with layout `l`.
-    fn input_cells(l: &Layout, i: usize) -> impl Iterator<Item = Option<Cell>> {
+    pub(super) fn input_cells(l: &Layout, i: usize) -> impl Iterator<Item = Option<Cell>> {
         let (src, dim) = l.inputs[i];
         (0..dim).map(move |k| match src {
             Source::Time => None,
@@ -257,86 +249,6 @@ impl StateEquations {
             scale: 1.0,
         }));
         srcs
-    }
-
-    /// The shape, rows, written columns and differenced cells of a block.
-    fn block_layout(
-        &self,
-        id: usize,
-        target: Target,
-        causality: &[crate::bond::PortCausality],
-    ) -> BlockLayout {
-        let l = &self.layouts[id];
-        let element = self.graph.node(id).element.as_ref();
-        let own_states = (0..l.n_states).map(|k| Cell::State(l.state_offset + k));
-        match target {
-            Target::Stage(s) => {
-                let stage = &element.stages(causality)[s];
-                let shape = LocalShape::stage(l, &stage.writes);
-                let mut rows = Vec::new();
-                let mut written = Vec::new();
-                for &(slot, _, dim) in shape.rows() {
-                    for k in 0..dim {
-                        match slot {
-                            Slot::Effort(p) => {
-                                rows.push((Cell::Effort(l.ports[p].offset + k), 1.0));
-                                written.push(shape.effort_col(p, k));
-                            }
-                            Slot::Flow(p) => {
-                                rows.push((Cell::Flow(l.ports[p].offset + k), l.ports[p].sign));
-                                written.push(shape.flow_col(p, k));
-                            }
-                            Slot::Output(i) | Slot::Input(i) => {
-                                rows.push((Cell::Signal(l.outputs[i].0 + k), 1.0));
-                            }
-                        }
-                    }
-                }
-                let mut cells = Vec::new();
-                for &slot in &stage.reads {
-                    match slot {
-                        Slot::Effort(p) => {
-                            let o = l.ports[p].offset;
-                            cells.extend((0..l.ports[p].dim).map(|k| Cell::Effort(o + k)));
-                        }
-                        Slot::Flow(p) => {
-                            let o = l.ports[p].offset;
-                            cells.extend((0..l.ports[p].dim).map(|k| Cell::Flow(o + k)));
-                        }
-                        Slot::Input(i) => cells.extend(Self::input_cells(l, i).flatten()),
-                        Slot::Output(_) => {}
-                    }
-                }
-                cells.extend(own_states);
-                BlockLayout {
-                    shape,
-                    rows,
-                    written,
-                    cells,
-                }
-            }
-            Target::Derivatives => {
-                let shape = LocalShape::derivatives(l);
-                let rows = (0..l.n_states)
-                    .map(|k| (Cell::Derivative(l.state_offset + k), 1.0))
-                    .collect();
-                let mut cells = Vec::new();
-                for p in &l.ports {
-                    cells.extend((0..p.dim).map(|k| Cell::Effort(p.offset + k)));
-                    cells.extend((0..p.dim).map(|k| Cell::Flow(p.offset + k)));
-                }
-                for i in 0..l.inputs.len() {
-                    cells.extend(Self::input_cells(l, i).flatten());
-                }
-                cells.extend(own_states);
-                BlockLayout {
-                    shape,
-                    rows,
-                    written: Vec::new(),
-                    cells,
-                }
-            }
-        }
     }
 
     /// Compile the Jacobian of the stages `order` (then every element's derivatives), with
