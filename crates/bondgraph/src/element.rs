@@ -255,6 +255,14 @@ pub trait Element: Debug {
         false
     }
 
+    /// Whether every partial this element gives ([`stage_partials`](Element::stage_partials),
+    /// [`derivative_partials`](Element::derivative_partials)) is the same at every (t, x): a
+    /// junction's ±1, a constant ratio or resistance. The Jacobian then asks for them once,
+    /// when its plan is compiled, and never again. `false` (the default) asks every time.
+    fn partials_are_constant(&self) -> bool {
+        false
+    }
+
     /// States the simulator should watch over a run, every accepted step (a chamber's
     /// minimum pressure, with a warning below the tank pressure).
     fn watches(&self) -> Vec<Watch> {

@@ -81,6 +81,9 @@ impl Element for Capacitor {
             *d = io.f_in(0, k);
         }
     }
+    fn partials_are_constant(&self) -> bool {
+        self.c.constant().is_some()
+    }
     fn stage_partials(&self, _: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
         // e = q/c(u)
         let c = self.c.value(io, 0);

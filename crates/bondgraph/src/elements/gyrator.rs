@@ -76,6 +76,9 @@ impl Element for Gyrator {
             }
         }
     }
+    fn partials_are_constant(&self) -> bool {
+        self.r.constant().is_some()
+    }
     fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
         let r = self.r.value(io, 0);
         let impedance = io.causality(0) == PortCausality::EffortOut;

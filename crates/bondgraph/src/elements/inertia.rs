@@ -103,6 +103,9 @@ impl Element for Inertia {
             *d = io.e(0, k);
         }
     }
+    fn partials_are_constant(&self) -> bool {
+        self.m.constant().is_some()
+    }
     fn stage_partials(&self, _: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
         // f_in = p/(m(u)·w)
         let m = self.m.value(io, 0);

@@ -176,6 +176,9 @@ impl Element for ZeroJunction {
             balance(io.flow, io.layout, d);
         }
     }
+    fn partials_are_constant(&self) -> bool {
+        true
+    }
     fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
         let d = dominant(io, PortCausality::FlowOut);
         for k in 0..io.dim(d) {
@@ -222,6 +225,9 @@ impl Element for OneJunction {
             // Σ s_p e_p = 0 over all ports (s: +1 into the junction).
             balance(io.effort, io.layout, d);
         }
+    }
+    fn partials_are_constant(&self) -> bool {
+        true
     }
     fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
         let d = dominant(io, PortCausality::EffortOut);

@@ -54,6 +54,9 @@ impl Element for Resistor {
             }
         }
     }
+    fn partials_are_constant(&self) -> bool {
+        self.r.constant().is_some()
+    }
     fn stage_partials(&self, _: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
         let r = self.r.value(io, 0);
         for k in 0..io.dim(0) {

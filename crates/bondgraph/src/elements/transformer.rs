@@ -79,6 +79,9 @@ impl Element for Transformer {
             }
         }
     }
+    fn partials_are_constant(&self) -> bool {
+        self.m.constant().is_some()
+    }
     fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
         let m = self.m.value(io, 0);
         let forward = io.causality(0) == PortCausality::EffortOut;

@@ -17,6 +17,8 @@
 //! work of a Jacobian is the number of nonzero partials times the pattern sizes they carry.
 //!
 //! - `compile`: the plan of updates, gradient patterns, local-block structures.
+//! - `constant`: the partials of elements that say they are constant, asked for once.
+//! - `layout`: a block's shape, rows and cells before it is compiled.
 //! - `pass`: one pass of the plan carrying gradients, local differences.
 //! - `sparse`: the sparsity pattern and the sparse target.
 //! - `outputs`: ∂y/∂x and ∂y/∂u of any probe (linearisation).
@@ -27,6 +29,8 @@ use bg_solver::SparsePattern;
 use nalgebra::DMatrix;
 
 mod compile;
+mod constant;
+mod layout;
 mod outputs;
 mod pass;
 mod sparse;

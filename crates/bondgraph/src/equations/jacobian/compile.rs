@@ -12,8 +12,11 @@
 
 use std::ops::Range;
 
-use crate::element::{Element, Io, Layout, Slot, Source};
+use crate::element::{Element, Io, Layout, Source};
 use crate::local_jacobian::{LocalJacobian, LocalShape, DENSE_MAX_COLS, DENSE_MAX_ENTRIES};
+
+use super::constant::{aliases, constant_partials, Constant};
+use super::layout::BlockLayout;
 
 use super::super::StateEquations;
 
@@ -50,7 +53,7 @@ pub(super) struct Src {
 }
 
 impl Src {
-    const NONE: Self = Self {
+    pub(super) const NONE: Self = Self {
         span: Span::EMPTY,
         scale: 1.0,
     };
@@ -128,6 +131,9 @@ pub(super) struct BlockCode {
     pub(super) entries: Option<Entries>,
     /// The local difference, if it gives none (always for a dense block).
     pub(super) diffs: Option<Differences>,
+    /// The nonzero partials in storage order, if the element's partials are constant
+    /// ([`Element::partials_are_constant`]): the pass then neither asks for nor scans them.
+    pub(super) constant: Option<Vec<Constant>>,
 }
 
 /// The compiled Jacobian of one order of the plan.
@@ -140,23 +146,15 @@ pub(in crate::equations) struct Compiled {
     pub(super) blocks: Vec<BlockCode>,
     /// The runs of every entry, block after block.
     pub(super) updates: Vec<Run>,
-    /// Each effort, flow and signal scalar's gradient after the pass.
-    pub(super) slots: Vec<Span>,
+    /// Each effort, flow and signal scalar's gradient after the pass, and the factor (±1)
+    /// from it to the scalar (a row that aliases another scalar's gradient).
+    pub(super) slots: Vec<Src>,
     /// The Jacobian's rows: state index and gradient.
     pub(super) rows: Vec<(usize, Span)>,
     pub(super) max_entries: usize,
     pub(super) max_rows: usize,
     /// `max_rows + 1` zeros: the structure of a block compiled without partials.
     pub(super) no_structure: Vec<u32>,
-}
-
-/// A block before compiling: its shape, rows (cell, factor), the columns it writes and the
-/// cells a local difference reads.
-struct BlockLayout {
-    shape: LocalShape,
-    rows: Vec<(Cell, f64)>,
-    written: Vec<usize>,
-    cells: Vec<Cell>,
 }
 
 impl Entries {
@@ -190,16 +188,18 @@ fn union(cols: &[u32], srcs: impl Iterator<Item = Src>) -> Vec<u32> {
 
 impl StateEquations {
     /// The gradient of a cell as compiled so far.
-    fn src_of(&self, slots: &[Span], cell: Cell) -> Src {
+    fn src_of(&self, slots: &[Src], cell: Cell) -> Src {
         let nb = self.n_bond_values;
-        let span = match cell {
+        match cell {
             Cell::Effort(o) => slots[o],
             Cell::Flow(o) => slots[nb + o],
             Cell::Signal(o) => slots[2 * nb + o],
-            Cell::State(i) => Span::unit(i),
-            Cell::Derivative(_) => Span::EMPTY,
-        };
-        Src { span, scale: 1.0 }
+            Cell::State(i) => Src {
+                span: Span::unit(i),
+                scale: 1.0,
+            },
+            Cell::Derivative(_) => Src::NONE,
+        }
     }
 
     /// The slot index of a stored effort, flow or signal cell.
@@ -214,7 +214,7 @@ impl StateEquations {
     }
 
     /// The cells of signal input `i` of an element with layout `l`.
-    fn input_cells(l: &Layout, i: usize) -> impl Iterator<Item = Option<Cell>> {
+    pub(super) fn input_cells(l: &Layout, i: usize) -> impl Iterator<Item = Option<Cell>> {
         let (src, dim) = l.inputs[i];
         (0..dim).map(move |k| match src {
             Source::Time => None,
@@ -226,14 +226,17 @@ impl StateEquations {
     }
 
     /// The gradient of every local column of element `id`, in column order.
-    fn column_srcs(&self, id: usize, slots: &[Span]) -> Vec<Src> {
+    fn column_srcs(&self, id: usize, slots: &[Src]) -> Vec<Src> {
         let l = &self.layouts[id];
         let mut srcs = Vec::new();
         for p in &l.ports {
             srcs.extend((0..p.dim).map(|k| self.src_of(slots, Cell::Effort(p.offset + k))));
-            srcs.extend((0..p.dim).map(|k| Src {
-                scale: p.sign,
-                ..self.src_of(slots, Cell::Flow(p.offset + k))
+            srcs.extend((0..p.dim).map(|k| {
+                let s = self.src_of(slots, Cell::Flow(p.offset + k));
+                Src {
+                    scale: p.sign * s.scale,
+                    ..s
+                }
             }));
         }
         for i in 0..l.inputs.len() {
@@ -246,86 +249,6 @@ impl StateEquations {
             scale: 1.0,
         }));
         srcs
-    }
-
-    /// The shape, rows, written columns and differenced cells of a block.
-    fn block_layout(
-        &self,
-        id: usize,
-        target: Target,
-        causality: &[crate::bond::PortCausality],
-    ) -> BlockLayout {
-        let l = &self.layouts[id];
-        let element = self.graph.node(id).element.as_ref();
-        let own_states = (0..l.n_states).map(|k| Cell::State(l.state_offset + k));
-        match target {
-            Target::Stage(s) => {
-                let stage = &element.stages(causality)[s];
-                let shape = LocalShape::stage(l, &stage.writes);
-                let mut rows = Vec::new();
-                let mut written = Vec::new();
-                for &(slot, _, dim) in shape.rows() {
-                    for k in 0..dim {
-                        match slot {
-                            Slot::Effort(p) => {
-                                rows.push((Cell::Effort(l.ports[p].offset + k), 1.0));
-                                written.push(shape.effort_col(p, k));
-                            }
-                            Slot::Flow(p) => {
-                                rows.push((Cell::Flow(l.ports[p].offset + k), l.ports[p].sign));
-                                written.push(shape.flow_col(p, k));
-                            }
-                            Slot::Output(i) | Slot::Input(i) => {
-                                rows.push((Cell::Signal(l.outputs[i].0 + k), 1.0));
-                            }
-                        }
-                    }
-                }
-                let mut cells = Vec::new();
-                for &slot in &stage.reads {
-                    match slot {
-                        Slot::Effort(p) => {
-                            let o = l.ports[p].offset;
-                            cells.extend((0..l.ports[p].dim).map(|k| Cell::Effort(o + k)));
-                        }
-                        Slot::Flow(p) => {
-                            let o = l.ports[p].offset;
-                            cells.extend((0..l.ports[p].dim).map(|k| Cell::Flow(o + k)));
-                        }
-                        Slot::Input(i) => cells.extend(Self::input_cells(l, i).flatten()),
-                        Slot::Output(_) => {}
-                    }
-                }
-                cells.extend(own_states);
-                BlockLayout {
-                    shape,
-                    rows,
-                    written,
-                    cells,
-                }
-            }
-            Target::Derivatives => {
-                let shape = LocalShape::derivatives(l);
-                let rows = (0..l.n_states)
-                    .map(|k| (Cell::Derivative(l.state_offset + k), 1.0))
-                    .collect();
-                let mut cells = Vec::new();
-                for p in &l.ports {
-                    cells.extend((0..p.dim).map(|k| Cell::Effort(p.offset + k)));
-                    cells.extend((0..p.dim).map(|k| Cell::Flow(p.offset + k)));
-                }
-                for i in 0..l.inputs.len() {
-                    cells.extend(Self::input_cells(l, i).flatten());
-                }
-                cells.extend(own_states);
-                BlockLayout {
-                    shape,
-                    rows,
-                    written: Vec::new(),
-                    cells,
-                }
-            }
-        }
     }
 
     /// Compile the Jacobian of the stages `order` (then every element's derivatives), with
@@ -348,7 +271,7 @@ impl StateEquations {
             cols: (0..width as u32).collect(),
             blocks: Vec::new(),
             updates: Vec::new(),
-            slots: vec![Span::EMPTY; n_slots],
+            slots: vec![Src::NONE; n_slots],
             rows: Vec::new(),
             max_entries: 0,
             max_rows: 0,
@@ -440,7 +363,7 @@ impl StateEquations {
                 (true, true, None)
             };
             // The pattern of each row.
-            let patterns: Vec<Vec<u32>> = match &structure {
+            let mut patterns: Vec<Vec<u32>> = match &structure {
                 Some((row_ptr, cols)) if !with_diffs => (0..m)
                     .map(|r| {
                         let (a, e) = (row_ptr[r] as usize, row_ptr[r + 1] as usize);
@@ -461,6 +384,18 @@ impl StateEquations {
                     vec![all; m]
                 }
             };
+            // A row that is ±1 times one column of the same pattern (a junction's shared
+            // effort or flow) is that column's gradient: no place or updates of its own.
+            let alias = if structure.is_some() && !with_diffs && element.partials_are_constant() {
+                aliases(element, target, &io, &shape, &rows, &col_srcs, &patterns)
+            } else {
+                vec![None; m]
+            };
+            for (p, a) in patterns.iter_mut().zip(&alias) {
+                if a.is_some() {
+                    p.clear();
+                }
+            }
             let start = c.cols.len();
             let mut row_spans = Vec::with_capacity(m);
             for p in &patterns {
@@ -554,15 +489,25 @@ impl StateEquations {
                     first,
                 }
             });
+            let constant = entries
+                .as_ref()
+                .filter(|_| element.partials_are_constant())
+                .and_then(|e| constant_partials(element, target, &io, &shape, e));
             // What the block wrote now has its gradient.
             for (r, &(cell, _)) in rows.iter().enumerate() {
                 if let Cell::Derivative(i) = cell {
                     c.rows.push((i, row_spans[r]));
                 } else if let Some(g) = self.slot_of(cell) {
-                    c.slots[g] = row_spans[r];
+                    c.slots[g] = alias[r].unwrap_or(Src {
+                        span: row_spans[r],
+                        scale: 1.0,
+                    });
                     if let Cell::Signal(o) = cell {
                         if let Some(s) = seeds.iter().position(|&s| s == o) {
-                            c.slots[g] = Span::unit(n + s);
+                            c.slots[g] = Src {
+                                span: Span::unit(n + s),
+                                scale: 1.0,
+                            };
                         }
                     }
                 }
@@ -577,6 +522,7 @@ impl StateEquations {
                 out,
                 entries,
                 diffs,
+                constant,
             });
         }
         c.no_structure = vec![0; c.max_rows + 1];

@@ -60,7 +60,9 @@ impl StateEquations {
         let nb = self.n_bond_values;
         // Row k += scale · gradient of slot g.
         let add = |out: &mut DMatrix<f64>, k: usize, g: usize, scale: f64| {
-            for q in code.slots[g].range() {
+            let src = code.slots[g];
+            let scale = scale * src.scale;
+            for q in src.span.range() {
                 out[(k, code.cols[q] as usize)] += scale * w.g[q];
             }
         };

@@ -49,7 +49,7 @@ impl Work {
 }
 
 /// `g[d..d + len] += c · g[s..s + len]` for every run.
-#[inline]
+#[inline(always)]
 fn apply(g: &mut [f64], runs: &[Run], c: f64) {
     for run in runs {
         let (d, s, len) = (run.d as usize, run.s as usize, run.len as usize);
@@ -213,9 +213,20 @@ impl<'a> Pass<'a> {
     fn block(&mut self, b: &BlockCode) {
         self.eval(b.id, b.target);
         self.w.g[b.out.range()].fill(0.0);
-        let gives = self.partials(b);
         let code = self.code;
         let updates = &code.updates;
+        if let Some(constant) = &b.constant {
+            // the partials compiled once, nonzero ones in storage order
+            for k in constant {
+                apply(
+                    &mut self.w.g,
+                    &updates[k.first as usize..k.end as usize],
+                    k.c,
+                );
+            }
+            return;
+        }
+        let gives = self.partials(b);
         let w = &mut *self.w;
         if let Some(e) = &b.entries {
             // Entry by entry in storage order (row by row, columns ascending), each value
@@ -224,30 +235,39 @@ impl<'a> Pass<'a> {
                 Storage::Dense(Some(mask)) => Some(mask),
                 _ => None,
             };
+            // the block's slices, bounded once
+            let n = e.len;
+            let (local, fac, first) = (&mut w.local[..n], &e.fac[..n], &e.first[..=n]);
             // small blocks (mostly nonzero) are read entry by entry
-            let chunked = e.len >= CHUNKED_MIN;
-            let step = if chunked { CHUNK } else { e.len.max(1) };
-            for start in (0..e.len).step_by(step) {
-                let end = e.len.min(start + step);
-                if chunked && all_zero(&w.local[start..end]) {
+            let chunked = n >= CHUNKED_MIN;
+            let step = if chunked { CHUNK } else { n };
+            let mut start = 0;
+            while start < n {
+                let end = n.min(start + step);
+                if chunked && all_zero(&local[start..end]) {
+                    start = end;
                     continue;
                 }
                 for i in start..end {
-                    let v = w.local[i];
+                    let v = local[i];
                     if v == 0.0 {
                         continue;
                     }
-                    w.local[i] = 0.0;
+                    local[i] = 0.0;
                     if !gives {
                         continue;
                     }
-                    let run = e.first[i] as usize..e.first[i + 1] as usize;
-                    if run.is_empty() && mask.is_some_and(|m| !m[i]) {
-                        // outside a wide block's structure
-                        self.stale = true;
+                    let (a, z) = (first[i] as usize, first[i + 1] as usize);
+                    if a == z {
+                        if mask.is_some_and(|m| !m[i]) {
+                            // outside a wide block's structure
+                            self.stale = true;
+                        }
+                        continue;
                     }
-                    apply(&mut w.g, &updates[run], v * e.fac[i]);
+                    apply(&mut w.g, &updates[a..z], v * fac[i]);
                 }
+                start = end;
             }
         }
         if gives {
