@@ -81,6 +81,11 @@ pub struct StateEquations {
     /// `order` without the stages whose results only outputs read, directly or through other
     /// such stages (skipped by `rhs`).
     rhs_order: Vec<(ElementId, usize)>,
+    /// `order` and `rhs_order` as flat [`Step`]s, run by `evaluate` and `rhs`.
+    steps: Vec<Step>,
+    rhs_steps: Vec<Step>,
+    /// The elements with states, in element order (their derivatives fill dx).
+    owners: Vec<Step>,
     /// Per element, per stage: the variables it writes (for diagnostics).
     writes: Vec<Vec<Vec<Var>>>,
     states: Vec<StateInfo>,
@@ -94,6 +99,15 @@ pub struct StateEquations {
     inputs: Vec<ElementId>,
     /// Whether a run stops and restarts at the inputs' breakpoints (default: yes).
     stop_at_breakpoints: bool,
+}
+
+/// One call of a plan, made flat at plan time: the element, which of its stages (0 for a
+/// call of its derivatives) and a copy of its layout, so the loops read no other table.
+#[derive(Clone, Debug)]
+struct Step {
+    id: ElementId,
+    stage: usize,
+    layout: Layout,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -152,6 +166,28 @@ impl StateEquations {
             })?;
         s.initial = value;
         Ok(())
+    }
+
+    /// `order` as [`Step`]s.
+    fn steps_of(&self, order: &[(ElementId, usize)]) -> Vec<Step> {
+        order
+            .iter()
+            .map(|&(id, stage)| Step {
+                id,
+                stage,
+                layout: self.layouts[id].clone(),
+            })
+            .collect()
+    }
+
+    /// The elements `ids` as [`Step`]s of their derivatives.
+    fn owners_of(&self, ids: impl Iterator<Item = ElementId>) -> Vec<Step> {
+        ids.map(|id| Step {
+            id,
+            stage: 0,
+            layout: self.layouts[id].clone(),
+        })
+        .collect()
     }
 
     /// Number of signal scalars.

@@ -1,7 +1,7 @@
 //! Evaluating the plan: the right-hand side dx/dt = f(t, x), every variable at a point (for
 //! probes, powers and energies), and the first variable that is not finite.
 
-use super::{Probe, StateEquations, Var, Workspace};
+use super::{Probe, StateEquations, Step, Var, Workspace};
 use crate::bond::ElementId;
 use crate::element::{Io, Layout};
 
@@ -24,13 +24,14 @@ impl StateEquations {
             signals,
             ..
         } = &mut *ws;
-        self.eval_into(&self.rhs_order, t, x, effort, flow, signals, dx);
+        self.eval_into(&self.rhs_steps, t, x, effort, flow, signals, dx);
     }
 
+    /// Run `steps`, then every state owner's derivatives into `dx`.
     #[allow(clippy::too_many_arguments)]
     fn eval_into(
         &self,
-        order: &[(ElementId, usize)],
+        steps: &[Step],
         t: f64,
         x: &[f64],
         effort: &mut [f64],
@@ -38,31 +39,15 @@ impl StateEquations {
         signals: &mut [f64],
         dx: &mut [f64],
     ) {
-        self.run_stages(order, t, x, effort, flow, signals);
-        let mut io = Io {
-            t,
-            x,
-            effort,
-            flow,
-            signals,
-            layout: &EMPTY,
-        };
-        for (id, l) in self.layouts.iter().enumerate() {
-            if l.n_states > 0 {
-                io.layout = l;
-                self.graph
-                    .node(id)
-                    .element
-                    .derivatives(&io, &mut dx[l.state_offset..l.state_offset + l.n_states]);
-            }
-        }
+        self.run_stages(steps, t, x, effort, flow, signals);
+        self.derivatives_of(&self.owners, t, x, effort, flow, signals, dx);
     }
 
-    /// Run the stages `order` (element, stage) at (t, x), in that order.
+    /// Run the stages `steps` at (t, x), in that order.
     #[inline]
     pub(super) fn run_stages(
         &self,
-        order: &[(ElementId, usize)],
+        steps: &[Step],
         t: f64,
         x: &[f64],
         effort: &mut [f64],
@@ -78,19 +63,19 @@ impl StateEquations {
             signals,
             layout: &EMPTY,
         };
-        for &(id, stage) in order {
-            io.layout = &self.layouts[id];
-            self.graph.node(id).element.eval(stage, &mut io);
+        for step in steps {
+            io.layout = &step.layout;
+            self.graph.node(step.id).element.eval(step.stage, &mut io);
         }
     }
 
-    /// The state derivatives of the elements `ids` (each with states) into their slices of
-    /// `dx`, from the values the stages left.
+    /// The state derivatives of `owners` (elements with states) into their slices of `dx`,
+    /// from the values the stages left.
     #[allow(clippy::too_many_arguments)]
     #[inline]
     pub(super) fn derivatives_of(
         &self,
-        ids: impl Iterator<Item = ElementId>,
+        owners: &[Step],
         t: f64,
         x: &[f64],
         effort: &mut [f64],
@@ -106,11 +91,11 @@ impl StateEquations {
             signals,
             layout: &EMPTY,
         };
-        for id in ids {
-            let l = &self.layouts[id];
+        for owner in owners {
+            let l = &owner.layout;
             io.layout = l;
             self.graph
-                .node(id)
+                .node(owner.id)
                 .element
                 .derivatives(&io, &mut dx[l.state_offset..l.state_offset + l.n_states]);
         }
@@ -125,7 +110,7 @@ impl StateEquations {
             signals,
             dx,
         } = &mut *ws;
-        self.eval_into(&self.order, t, x, effort, flow, signals, dx);
+        self.eval_into(&self.steps, t, x, effort, flow, signals, dx);
     }
 
     /// Read a probe after [`evaluate`](Self::evaluate) at (t, x).

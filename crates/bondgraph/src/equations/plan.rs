@@ -96,6 +96,9 @@ impl StateEquations {
             layouts,
             order: Vec::new(),
             rhs_order: Vec::new(),
+            steps: Vec::new(),
+            rhs_steps: Vec::new(),
+            owners: Vec::new(),
             writes: Vec::new(),
             states,
             bond_offset,
@@ -279,6 +282,10 @@ impl StateEquations {
             Ok(order) => {
                 self.order = order.into_iter().map(|ix| dep[ix]).collect();
                 self.rhs_order = self.rhs_stages();
+                self.steps = self.steps_of(&self.order);
+                self.rhs_steps = self.steps_of(&self.rhs_order);
+                let owners = (0..n_el).filter(|&id| self.layouts[id].n_states > 0);
+                self.owners = self.owners_of(owners);
                 Ok(())
             }
             Err(_) => Err(self.loop_error(&dep, &reads, &writer).into()),

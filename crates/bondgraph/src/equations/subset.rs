@@ -4,20 +4,33 @@
 //! A stage computes its writes from its reads only, so running the needed stages in plan
 //! order gives the probes bit for bit the values of a whole evaluation.
 
-use super::{Probe, StateEquations, Var, Workspace};
+use super::{Probe, StateEquations, Step, Var, Workspace};
 use crate::bond::{ElementId, PortCausality};
 use crate::element::Slot;
 
 /// What [`StateEquations::evaluate_only`] runs for a set of probes: the stages that compute
 /// them, in plan order, and the elements whose state derivatives they read. Made once by
 /// [`StateEquations::subset`]; evaluating it allocates nothing.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default)]
 pub struct Subset {
-    /// (element, stage), in plan order.
-    stages: Vec<(ElementId, usize)>,
-    /// Elements whose [`derivatives`](crate::element::Element::derivatives) are read.
-    derivatives: Vec<ElementId>,
+    /// The stages, in plan order.
+    stages: Vec<Step>,
+    /// Elements whose [`derivatives`](crate::element::Element::derivatives) are read, in
+    /// element order.
+    derivatives: Vec<Step>,
 }
+
+/// Two subsets are equal when they run the same stages and derivatives (the layouts are
+/// copies of the plan's).
+impl PartialEq for Subset {
+    fn eq(&self, other: &Self) -> bool {
+        let calls = |s: &[Step]| s.iter().map(|c| (c.id, c.stage)).collect::<Vec<_>>();
+        calls(&self.stages) == calls(&other.stages)
+            && calls(&self.derivatives) == calls(&other.derivatives)
+    }
+}
+
+impl Eq for Subset {}
 
 impl Subset {
     /// Number of stages run.
@@ -71,15 +84,16 @@ impl StateEquations {
             stack.extend(reads[k].iter().filter_map(&writer));
         }
         derivatives.sort_unstable();
+        let stages: Vec<(ElementId, usize)> = self
+            .order
+            .iter()
+            .zip(&needed)
+            .filter(|(_, &n)| n)
+            .map(|(&st, _)| st)
+            .collect();
         Subset {
-            stages: self
-                .order
-                .iter()
-                .zip(&needed)
-                .filter(|(_, &n)| n)
-                .map(|(&st, _)| st)
-                .collect(),
-            derivatives,
+            stages: self.steps_of(&stages),
+            derivatives: self.owners_of(derivatives.into_iter()),
         }
     }
 
@@ -94,8 +108,7 @@ impl StateEquations {
             dx,
         } = &mut *ws;
         self.run_stages(&subset.stages, t, x, effort, flow, signals);
-        let ids = subset.derivatives.iter().copied();
-        self.derivatives_of(ids, t, x, effort, flow, signals, dx);
+        self.derivatives_of(&subset.derivatives, t, x, effort, flow, signals, dx);
     }
 
     /// Forget every value evaluated so far (efforts, flows, signals and derivatives become

@@ -68,3 +68,38 @@ fn only_what_is_read_runs() {
     assert!((only(&eqs, &s, e, 0.0, &x) + 1.5).abs() < 1e-12);
     assert!(eqs.read(eqs.probe("mass.f").unwrap(), 0.0, &x).is_nan());
 }
+
+#[test]
+fn the_flat_steps_are_the_plan() {
+    // `steps`, `rhs_steps` and `owners` call what `order`, `rhs_order` and the layouts say,
+    // each with a copy of its element's layout.
+    let (eqs, probes, _) = msd();
+    let calls = |s: &[Step]| s.iter().map(|c| (c.id, c.stage)).collect::<Vec<_>>();
+    assert_eq!(calls(&eqs.steps), eqs.order);
+    assert_eq!(calls(&eqs.rhs_steps), eqs.rhs_order);
+    let owners: Vec<_> = (0..eqs.layouts.len())
+        .filter(|&id| eqs.layouts[id].n_states > 0)
+        .map(|id| (id, 0))
+        .collect();
+    assert_eq!(calls(&eqs.owners), owners);
+    assert_eq!(eqs.owners.len(), 2);
+    for c in eqs.steps.iter().chain(&eqs.owners) {
+        let l = &eqs.layouts[c.id];
+        let ports = |l: &crate::element::Layout| {
+            let p = l.ports.iter().map(|p| (p.offset, p.dim, p.sign.to_bits()));
+            p.collect::<Vec<_>>()
+        };
+        assert_eq!(ports(&c.layout), ports(l));
+        assert_eq!(c.layout.outputs, l.outputs);
+        assert_eq!(c.layout.inputs.len(), l.inputs.len());
+        assert_eq!(
+            (c.layout.state_offset, c.layout.n_states),
+            (l.state_offset, l.n_states)
+        );
+    }
+    // Subsets compare by the calls they make.
+    let all = eqs.subset(&probes);
+    assert_eq!(all, eqs.subset(&probes));
+    assert_ne!(all, eqs.subset(&[Probe::Derivative(0)]));
+    assert_ne!(all, Subset::default());
+}
