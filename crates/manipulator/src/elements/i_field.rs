@@ -245,7 +245,9 @@ impl Partials {
         }
         minv_b.copy_from(b);
         for col in minv_b.as_mut_slice().chunks_mut(n) {
-            factor.solve_in_place(col);
+            // from the first entry that is not +0 (column 0 of B is zero for a free base joint)
+            let first = col.iter().position(|v| v.to_bits() != 0).unwrap_or(n);
+            factor.solve_from(first, col);
         }
         // (BᵀM⁻¹B)_rc: columns r of B and c of M⁻¹B, contiguous (column-major)
         let (bs, xs) = (b.as_slice(), minv_b.as_slice());
@@ -258,13 +260,18 @@ impl Partials {
                 *d -= bt_x;
             }
         }
-        // the rows set into the LocalJacobian (the same values, gathered once)
-        for k in 0..n {
-            for c in 0..n {
-                let (s, t) = (2 * n * k + c, 2 * n * k + n + c);
-                (speed[s], speed[t]) = (minv[(k, c)], -minv_b[(k, c)]);
-                (pdot[s], pdot[t]) = (minv_b[(c, k)], dpdot_dq[(k, c)]);
+        let (ms, hs, w) = (minv.as_slice(), dpdot_dq.as_slice(), 2 * n); // the rows set
+        for (c, ((mc, xc), hc)) in ms
+            .chunks_exact(n)
+            .zip(xs.chunks_exact(n))
+            .zip(hs.chunks_exact(n))
+            .enumerate()
+        {
+            for k in 0..n {
+                (speed[w * k + c], speed[w * k + n + c]) = (mc[k], -xc[k]);
+                pdot[w * k + n + c] = hc[k];
             }
+            pdot[w * c..w * c + n].copy_from_slice(xc);
         }
     }
 }
@@ -577,18 +584,12 @@ impl Element for ArmInertia {
         let n = self.arm.n();
         let mut ws = self.ws.borrow_mut();
         let (_, d) = ws.partials(&self.arm, io.states());
-        for (r, (pr, sr)) in d
-            .pdot
-            .chunks_exact(2 * n)
-            .zip(d.speed.chunks_exact(2 * n))
-            .enumerate()
-        {
-            // ṗ = e + E(q, u(p, q))
-            let row = jac.derivative_row(r);
+        for r in 0..n {
+            // ṗ = e + E(q, u(p, q)), q̇ = u(p, q)
+            let (row, w) = (jac.derivative_row(r), 2 * n * r..2 * n * (r + 1));
             jac.set(row, jac.effort_col(0, r), 1.0);
-            set_row(jac, row, pr);
-            // q̇ = u(p, q)
-            set_row(jac, jac.derivative_row(n + r), sr);
+            set_row(jac, row, &d.pdot[w.clone()]);
+            set_row(jac, jac.derivative_row(n + r), &d.speed[w]);
         }
         true
     }
