@@ -231,6 +231,7 @@ impl Element for ActuatorTransformer {
         let (Lengths { tau, .. }, hessians, acc) =
             ws.with_hessians(&self.arm, &self.pins, io.input(0));
         let (n, n_act) = (self.arm.n(), self.pins.len());
+        let q0 = jac.input_col(0, 0); // the columns of q, contiguous
         match stage {
             0 => {
                 mtf_law::effort_partials(jac, tau);
@@ -243,7 +244,7 @@ impl Element for ActuatorTransformer {
                     let row = jac.row(Slot::Effort(0), k);
                     for l in 0..n {
                         let v: f64 = (0..n_act).map(|c| e2[c] * hessians[c][(k, l)]).sum();
-                        jac.set(row, jac.input_col(0, l), v);
+                        jac.set(row, q0 + l, v);
                     }
                 }
             }
@@ -258,7 +259,7 @@ impl Element for ActuatorTransformer {
                     let row = jac.row(Slot::Flow(1), c);
                     for l in 0..n {
                         let v: f64 = h.column(l).iter().zip(&*f1).map(|(h, f)| h * f).sum();
-                        jac.set(row, jac.input_col(0, l), -v);
+                        jac.set(row, q0 + l, -v);
                     }
                 }
             }
@@ -266,7 +267,7 @@ impl Element for ActuatorTransformer {
                 for c in 0..n_act {
                     let row = jac.row(Slot::Output(c), 0);
                     for l in 0..n {
-                        jac.set(row, jac.input_col(0, l), tau[(l, c)]);
+                        jac.set(row, q0 + l, tau[(l, c)]);
                     }
                 }
             }
@@ -280,7 +281,7 @@ impl Element for ActuatorTransformer {
                     }
                     for l in 0..n {
                         let v: f64 = h.column(l).iter().zip(io.flow(0)).map(|(h, f)| h * f).sum();
-                        jac.set(row, jac.input_col(0, l), v);
+                        jac.set(row, q0 + l, v);
                     }
                 }
             }
