@@ -81,7 +81,7 @@ impl Cholesky {
     /// `b ← M⁻¹ b` for a `b` whose entries before `first` are +0: the forward substitution
     /// starts at `first`. The same numbers as from 0: the skipped entries stay +0, and the
     /// skipped products are zeros that change no sum (`0 − (±0) = +0` where all are zero).
-    fn solve_from(&self, first: usize, b: &mut [f64]) {
+    pub(crate) fn solve_from(&self, first: usize, b: &mut [f64]) {
         let n = self.n;
         if !self.ok {
             b.fill(f64::NAN);

@@ -66,13 +66,13 @@ impl Modulus {
         arm: &PlanarArm,
         pins: &[(PinPoint, PinPoint)],
         q: &[f64],
-    ) -> (&Lengths, &[DMatrix<f64>]) {
+    ) -> (&Lengths, &[DMatrix<f64>], &mut [f64]) {
         let Self {
             frames,
             lengths,
             hessians,
             jd,
-            ..
+            acc,
         } = self;
         let lengths = lengths_at(lengths, frames, arm, pins, q);
         let (_, hessians) = hessians.get_or_update(q, |q, hessians| {
@@ -81,7 +81,7 @@ impl Modulus {
                 pose.actuator_length_hessian(a, b, jd, h);
             }
         });
-        (lengths, hessians)
+        (lengths, hessians, acc)
     }
 }
 
@@ -228,26 +228,38 @@ impl Element for ActuatorTransformer {
     }
     fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
         let mut ws = self.ws.borrow_mut();
-        let (Lengths { tau, .. }, hessians) = ws.with_hessians(&self.arm, &self.pins, io.input(0));
+        let (Lengths { tau, .. }, hessians, acc) =
+            ws.with_hessians(&self.arm, &self.pins, io.input(0));
         let (n, n_act) = (self.arm.n(), self.pins.len());
+        let q0 = jac.input_col(0, 0); // the columns of q, contiguous
         match stage {
             0 => {
                 mtf_law::effort_partials(jac, tau);
+                // (e₂ read once into acc)
+                let e2 = &mut acc[..n_act];
+                for (c, e) in e2.iter_mut().enumerate() {
+                    *e = io.e(1, c);
+                }
                 for k in 0..n {
                     let row = jac.row(Slot::Effort(0), k);
                     for l in 0..n {
-                        let v: f64 = (0..n_act).map(|c| io.e(1, c) * hessians[c][(k, l)]).sum();
-                        jac.set(row, jac.input_col(0, l), v);
+                        let v: f64 = (0..n_act).map(|c| e2[c] * hessians[c][(k, l)]).sum();
+                        jac.set(row, q0 + l, v);
                     }
                 }
             }
             1 => {
                 mtf_law::flow_partials(jac, tau);
+                // (f_in₁ read once into acc; column l of ∇²l_c is contiguous)
+                let f1 = &mut acc[..n];
+                for (k, f) in f1.iter_mut().enumerate() {
+                    *f = io.f_in(0, k);
+                }
                 for (c, h) in hessians.iter().enumerate() {
                     let row = jac.row(Slot::Flow(1), c);
                     for l in 0..n {
-                        let v: f64 = (0..n).map(|k| h[(k, l)] * io.f_in(0, k)).sum();
-                        jac.set(row, jac.input_col(0, l), -v);
+                        let v: f64 = h.column(l).iter().zip(&*f1).map(|(h, f)| h * f).sum();
+                        jac.set(row, q0 + l, -v);
                     }
                 }
             }
@@ -255,7 +267,7 @@ impl Element for ActuatorTransformer {
                 for c in 0..n_act {
                     let row = jac.row(Slot::Output(c), 0);
                     for l in 0..n {
-                        jac.set(row, jac.input_col(0, l), tau[(l, c)]);
+                        jac.set(row, q0 + l, tau[(l, c)]);
                     }
                 }
             }
@@ -268,8 +280,8 @@ impl Element for ActuatorTransformer {
                         jac.set(row, jac.flow_col(0, k), sign * tau[(k, c)]);
                     }
                     for l in 0..n {
-                        let v: f64 = (0..n).map(|k| h[(k, l)] * io.flow(0)[k]).sum();
-                        jac.set(row, jac.input_col(0, l), v);
+                        let v: f64 = h.column(l).iter().zip(io.flow(0)).map(|(h, f)| h * f).sum();
+                        jac.set(row, q0 + l, v);
                     }
                 }
             }

@@ -92,13 +92,18 @@ struct AtState {
     kinetic: f64,
 }
 
-/// M⁻¹, B, M⁻¹B and `H − BᵀM⁻¹B` at one state.
+/// M⁻¹, B, M⁻¹B and `H − BᵀM⁻¹B` at one state, and the rows of the partials as the
+/// LocalJacobian takes them (its state columns p then q are contiguous).
 #[derive(Debug)]
 struct Partials {
     minv: DMatrix<f64>,
     b: DMatrix<f64>,
     minv_b: DMatrix<f64>,
     dpdot_dq: DMatrix<f64>,
+    /// Row-major n × 2n: row k is `∂u_k/∂(p, q)` = (row k of M⁻¹, row k of −M⁻¹B).
+    speed: Vec<f64>,
+    /// Row-major n × 2n: row r is `∂ṗ_r/∂(p, q)` = (column r of M⁻¹B, row r of `H − BᵀM⁻¹B`).
+    pdot: Vec<f64>,
 }
 
 const OUT_U: usize = 0;
@@ -131,6 +136,8 @@ impl Motion {
                     b: DMatrix::zeros(n, n),
                     minv_b: DMatrix::zeros(n, n),
                     dpdot_dq: DMatrix::zeros(n, n),
+                    speed: vec![0.0; 2 * n * n],
+                    pdot: vec![0.0; 2 * n * n],
                 },
             ),
             udot: vec![0.0; n],
@@ -226,6 +233,8 @@ impl Partials {
             b,
             minv_b,
             dpdot_dq,
+            speed,
+            pdot,
         } = self;
         let AtState { factor, u, .. } = state;
         let n = arm.n();
@@ -236,7 +245,9 @@ impl Partials {
         }
         minv_b.copy_from(b);
         for col in minv_b.as_mut_slice().chunks_mut(n) {
-            factor.solve_in_place(col);
+            // from the first entry that is not +0 (column 0 of B is zero for a free base joint)
+            let first = col.iter().position(|v| v.to_bits() != 0).unwrap_or(n);
+            factor.solve_from(first, col);
         }
         // (BᵀM⁻¹B)_rc: columns r of B and c of M⁻¹B, contiguous (column-major)
         let (bs, xs) = (b.as_slice(), minv_b.as_slice());
@@ -249,6 +260,27 @@ impl Partials {
                 *d -= bt_x;
             }
         }
+        let (ms, hs, w) = (minv.as_slice(), dpdot_dq.as_slice(), 2 * n); // the rows set
+        for (c, ((mc, xc), hc)) in ms
+            .chunks_exact(n)
+            .zip(xs.chunks_exact(n))
+            .zip(hs.chunks_exact(n))
+            .enumerate()
+        {
+            for k in 0..n {
+                (speed[w * k + c], speed[w * k + n + c]) = (mc[k], -xc[k]);
+                pdot[w * k + n + c] = hc[k];
+            }
+            pdot[w * c..w * c + n].copy_from_slice(xc);
+        }
+    }
+}
+
+/// Entries (row, state column c) = `values[c]`, c = 0, 1, … (the state columns are contiguous).
+fn set_row(jac: &mut LocalJacobian<'_>, row: usize, values: &[f64]) {
+    let first = jac.state_col(0);
+    for (c, &v) in values.iter().enumerate() {
+        jac.set(row, first + c, v);
     }
 }
 
@@ -489,10 +521,7 @@ impl Element for ArmInertia {
         let (_, d) = partials.get_or_update(x, |x, d| d.compute(&self.arm, x, state, frames));
         // ∂u_k/∂(p, q) into row `row`.
         let speed_row = |jac: &mut LocalJacobian<'_>, row: usize, k: usize| {
-            for c in 0..n {
-                jac.set(row, jac.state_col(c), d.minv[(k, c)]);
-                jac.set(row, jac.state_col(n + c), -d.minv_b[(k, c)]);
-            }
+            set_row(jac, row, &d.speed[2 * n * k..2 * n * (k + 1)]);
         };
         match stage {
             0 => {
@@ -556,19 +585,11 @@ impl Element for ArmInertia {
         let mut ws = self.ws.borrow_mut();
         let (_, d) = ws.partials(&self.arm, io.states());
         for r in 0..n {
-            // ṗ = e + E(q, u(p, q))
-            let row = jac.derivative_row(r);
+            // ṗ = e + E(q, u(p, q)), q̇ = u(p, q)
+            let (row, w) = (jac.derivative_row(r), 2 * n * r..2 * n * (r + 1));
             jac.set(row, jac.effort_col(0, r), 1.0);
-            for c in 0..n {
-                jac.set(row, jac.state_col(c), d.minv_b[(c, r)]);
-                jac.set(row, jac.state_col(n + c), d.dpdot_dq[(r, c)]);
-            }
-            // q̇ = u(p, q)
-            let row = jac.derivative_row(n + r);
-            for c in 0..n {
-                jac.set(row, jac.state_col(c), d.minv[(r, c)]);
-                jac.set(row, jac.state_col(n + c), -d.minv_b[(r, c)]);
-            }
+            set_row(jac, row, &d.pdot[w.clone()]);
+            set_row(jac, jac.derivative_row(n + r), &d.speed[w]);
         }
         true
     }
