@@ -44,17 +44,14 @@ impl ComplexLu {
     pub(crate) fn set_shifted(&mut self, diag: Complex<f64>, jac: &[f64]) {
         let (n, ld) = (self.n, self.ld);
         for k in 0..n {
-            let (re, im) = (
-                &mut self.re[k * ld..k * ld + n],
-                &mut self.im[k * ld..k * ld + n],
-            );
-            // One pass over both planes (a separate `fill` was a memset call per column).
-            for ((r, m), &j) in re.iter_mut().zip(im.iter_mut()).zip(&jac[k * n..k * n + n]) {
-                *r = -j;
-                *m = 0.0;
+            let (dst, src) = (&mut self.re[k * ld..k * ld + n], &jac[k * n..k * n + n]);
+            for (d, &j) in dst.iter_mut().zip(src) {
+                *d = -j;
             }
-            re[k] += diag.re;
-            im[k] += diag.im;
+            dst[k] += diag.re;
+            let dst = &mut self.im[k * ld..k * ld + n];
+            dst.fill(0.0);
+            dst[k] += diag.im;
         }
     }
 
