@@ -223,6 +223,10 @@ impl<'a> Pass<'a> {
     /// local difference.
     fn block(&mut self, b: &BlockCode) {
         self.eval(b.id, b.target);
+        debug_assert!(
+            self.w.g[b.out.range()].iter().all(|&v| v == 0.0),
+            "a block's gradients are cleared at the start of the pass and written only by it"
+        );
         let code = self.code;
         let updates = &code.updates;
         if let Some(constant) = &b.constant {
