@@ -125,7 +125,7 @@ pub(super) struct BlockCode {
     /// Per local row: its cell and the factor from the local value to the stored one (the
     /// port's sign for an `f_in` row).
     pub(super) rows: Vec<(Cell, f64)>,
-    /// The gradients of all its rows, one after the other (zeroed before the block).
+    /// The gradients of all its rows, one after the other (zeroed at the start of a pass).
     pub(super) out: Span,
     /// The element's partials, if it gives them (always for a dense block).
     pub(super) entries: Option<Entries>,

@@ -76,6 +76,14 @@ fn all_zero(values: &[f64]) -> bool {
     values.iter().fold(0u64, |acc, v| acc | v.to_bits()) << 1 == 0
 }
 
+/// Set `values` to 0 in pieces of 1 KiB: below glibc's `rep stosb` threshold (2 KiB), so
+/// `memset` uses vector stores (`black_box` keeps the pieces from being merged into one).
+pub(super) fn clear(values: &mut [f64]) {
+    for piece in values.chunks_mut(128) {
+        std::hint::black_box(piece).fill(0.0);
+    }
+}
+
 /// One Jacobian pass: the plan's values and the gradient workspace.
 pub(super) struct Pass<'a> {
     eqs: &'a StateEquations,
@@ -102,6 +110,9 @@ impl<'a> Pass<'a> {
         x: &[f64],
     ) -> bool {
         w.x.copy_from_slice(x);
+        // every block's gradients (its `out`, disjoint and in plan order after the unit
+        // gradients) start from 0, cleared here at once rather than block by block
+        clear(&mut w.g[code.width..]);
         let mut pass = Pass {
             eqs,
             code,
@@ -212,7 +223,10 @@ impl<'a> Pass<'a> {
     /// local difference.
     fn block(&mut self, b: &BlockCode) {
         self.eval(b.id, b.target);
-        self.w.g[b.out.range()].fill(0.0);
+        debug_assert!(
+            self.w.g[b.out.range()].iter().all(|&v| v == 0.0),
+            "a block's gradients are cleared at the start of the pass and written only by it"
+        );
         let code = self.code;
         let updates = &code.updates;
         if let Some(constant) = &b.constant {
