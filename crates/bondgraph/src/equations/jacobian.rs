@@ -83,8 +83,8 @@ impl StateEquations {
         if jac.shape() != (n, n) {
             *jac = DMatrix::zeros(n, n);
         }
-        // the storage as one slice: memsets, not nalgebra's element iterator
-        pass::clear(jac.as_mut_slice());
+        // the storage as one slice: a memset, not nalgebra's element iterator
+        jac.as_mut_slice().fill(0.0);
         self.jacobian_into(t, x, &mut Out::Dense(jac));
     }
 

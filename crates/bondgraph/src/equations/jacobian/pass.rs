@@ -76,14 +76,6 @@ fn all_zero(values: &[f64]) -> bool {
     values.iter().fold(0u64, |acc, v| acc | v.to_bits()) << 1 == 0
 }
 
-/// Set `values` to 0 in pieces of 1 KiB: below glibc's `rep stosb` threshold (2 KiB), so
-/// `memset` uses vector stores (`black_box` keeps the pieces from being merged into one).
-pub(super) fn clear(values: &mut [f64]) {
-    for piece in values.chunks_mut(128) {
-        std::hint::black_box(piece).fill(0.0);
-    }
-}
-
 /// One Jacobian pass: the plan's values and the gradient workspace.
 pub(super) struct Pass<'a> {
     eqs: &'a StateEquations,
@@ -112,7 +104,7 @@ impl<'a> Pass<'a> {
         w.x.copy_from_slice(x);
         // every block's gradients (its `out`, disjoint and in plan order after the unit
         // gradients) start from 0, cleared here at once rather than block by block
-        clear(&mut w.g[code.width..]);
+        w.g[code.width..].fill(0.0);
         let mut pass = Pass {
             eqs,
             code,
