@@ -350,13 +350,7 @@ impl PlanarArm {
 
 impl SharedFrames {
     fn is_at(&self, q: &[f64]) -> bool {
-        self.valid
-            && self.q.len() == q.len()
-            && self
-                .q
-                .iter()
-                .zip(q)
-                .all(|(a, b)| a.to_bits() == b.to_bits())
+        self.valid && crate::elements::same_bits(&self.q, q)
     }
 }
 

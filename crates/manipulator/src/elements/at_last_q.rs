@@ -46,14 +46,14 @@ impl<T> AtLastQ<T> {
 
     /// Whether the value is the one at `q`.
     pub(crate) fn is_at(&self, q: &[f64]) -> bool {
-        self.valid
-            && self.q.len() == q.len()
-            && self
-                .q
-                .iter()
-                .zip(q)
-                .all(|(a, b)| a.to_bits() == b.to_bits())
+        self.valid && same_bits(&self.q, q)
     }
+}
+
+/// Whether `a` and `b` hold the same numbers bit for bit (so −0 ≠ +0 and a NaN equals
+/// itself): the test of every per-configuration cache of the arm.
+pub(crate) fn same_bits(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
 }
 
 #[cfg(test)]

@@ -28,6 +28,7 @@ mod r_field;
 mod reaction_block;
 
 pub use actuator_mtf::ActuatorTransformer;
+pub(crate) use at_last_q::same_bits;
 pub use c_field::ArmCompliance;
 pub use i_field::ArmInertia;
 pub use lumped_gravity::LumpedGravity;
