@@ -24,35 +24,50 @@ impl StateEquations {
             signals,
             ..
         } = &mut *ws;
-        self.eval_into(&self.rhs_steps, t, x, effort, flow, signals, dx);
+        self.run(
+            &self.rhs_steps,
+            &self.owners,
+            t,
+            x,
+            effort,
+            flow,
+            signals,
+            dx,
+        );
     }
 
-    /// Run `steps`, then every state owner's derivatives into `dx`.
+    /// Evaluate everything at (t, x) and keep it for [`read`](Self::read).
+    pub fn evaluate(&self, t: f64, x: &[f64]) {
+        self.evaluate_steps(&self.steps, &self.owners, t, x);
+    }
+
+    /// Run `steps` and then `owners`' derivatives at (t, x) into the workspace, kept for
+    /// [`read`](Self::read) (what `evaluate` and `evaluate_only` share).
+    pub(super) fn evaluate_steps(&self, steps: &[Step], owners: &[Step], t: f64, x: &[f64]) {
+        let mut ws = self.ws.borrow_mut();
+        let Workspace {
+            effort,
+            flow,
+            signals,
+            dx,
+        } = &mut *ws;
+        self.run(steps, owners, t, x, effort, flow, signals, dx);
+    }
+
+    /// Run the stages `steps` at (t, x), in that order, then the derivatives of `owners`
+    /// (elements with states) into their slices of `dx` from the values the stages left.
     #[allow(clippy::too_many_arguments)]
-    fn eval_into(
+    #[inline]
+    fn run(
         &self,
         steps: &[Step],
+        owners: &[Step],
         t: f64,
         x: &[f64],
         effort: &mut [f64],
         flow: &mut [f64],
         signals: &mut [f64],
         dx: &mut [f64],
-    ) {
-        self.run_stages(steps, t, x, effort, flow, signals);
-        self.derivatives_of(&self.owners, t, x, effort, flow, signals, dx);
-    }
-
-    /// Run the stages `steps` at (t, x), in that order.
-    #[inline]
-    pub(super) fn run_stages(
-        &self,
-        steps: &[Step],
-        t: f64,
-        x: &[f64],
-        effort: &mut [f64],
-        flow: &mut [f64],
-        signals: &mut [f64],
     ) {
         // one view, re-pointed at each stage's layout
         let mut io = Io {
@@ -67,30 +82,6 @@ impl StateEquations {
             io.layout = &step.layout;
             self.graph.node(step.id).element.eval(step.stage, &mut io);
         }
-    }
-
-    /// The state derivatives of `owners` (elements with states) into their slices of `dx`,
-    /// from the values the stages left.
-    #[allow(clippy::too_many_arguments)]
-    #[inline]
-    pub(super) fn derivatives_of(
-        &self,
-        owners: &[Step],
-        t: f64,
-        x: &[f64],
-        effort: &mut [f64],
-        flow: &mut [f64],
-        signals: &mut [f64],
-        dx: &mut [f64],
-    ) {
-        let mut io = Io {
-            t,
-            x,
-            effort,
-            flow,
-            signals,
-            layout: &EMPTY,
-        };
         for owner in owners {
             let l = &owner.layout;
             io.layout = l;
@@ -99,18 +90,6 @@ impl StateEquations {
                 .element
                 .derivatives(&io, &mut dx[l.state_offset..l.state_offset + l.n_states]);
         }
-    }
-
-    /// Evaluate everything at (t, x) and keep it for [`read`](Self::read).
-    pub fn evaluate(&self, t: f64, x: &[f64]) {
-        let mut ws = self.ws.borrow_mut();
-        let Workspace {
-            effort,
-            flow,
-            signals,
-            dx,
-        } = &mut *ws;
-        self.eval_into(&self.steps, t, x, effort, flow, signals, dx);
     }
 
     /// Read a probe after [`evaluate`](Self::evaluate) at (t, x).

@@ -4,7 +4,7 @@
 //! A stage computes its writes from its reads only, so running the needed stages in plan
 //! order gives the probes bit for bit the values of a whole evaluation.
 
-use super::{Probe, StateEquations, Step, Var, Workspace};
+use super::{Probe, StateEquations, Step, Var};
 use crate::bond::{ElementId, PortCausality};
 use crate::element::Slot;
 
@@ -100,15 +100,7 @@ impl StateEquations {
     /// Evaluate only `subset` at (t, x) and keep it for [`read`](Self::read): the probes it
     /// was made for read as after [`evaluate`](Self::evaluate); other variables are stale.
     pub fn evaluate_only(&self, subset: &Subset, t: f64, x: &[f64]) {
-        let mut ws = self.ws.borrow_mut();
-        let Workspace {
-            effort,
-            flow,
-            signals,
-            dx,
-        } = &mut *ws;
-        self.run_stages(&subset.stages, t, x, effort, flow, signals);
-        self.derivatives_of(&subset.derivatives, t, x, effort, flow, signals, dx);
+        self.evaluate_steps(&subset.stages, &subset.derivatives, t, x);
     }
 
     /// Forget every value evaluated so far (efforts, flows, signals and derivatives become
