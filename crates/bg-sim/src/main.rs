@@ -12,6 +12,7 @@ mod commands;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use commands::fatigue;
 use commands::{
     bench, check, compare, energy, fmu, graph, kinds, linearize, modes, plot, reduce, run, sweep,
     FAILED,
@@ -74,6 +75,9 @@ enum Command {
     /// Export the model as an FMI 2.0 (or --fmi 3) co-simulation FMU: the model and its data
     /// in resources/, the engine library (`cargo build -p bg-fmu`) in binaries/ (docs/fmu.md).
     Fmu(fmu::Args),
+    /// Rainflow-count a column of a results CSV (ASTM E1049-85) and its Palmgren–Miner
+    /// damage on an S–N curve (EN 1993-1-9, DNV-RP-C203 presets or explicit).
+    Fatigue(fatigue::Args),
 }
 
 fn main() -> ExitCode {
@@ -120,5 +124,6 @@ fn dispatch(command: Command) -> ExitCode {
         Command::Compare(a) => compare::command(&a),
         Command::Plot(a) => plot::command(&a),
         Command::Fmu(a) => fmu::command(&a),
+        Command::Fatigue(a) => fatigue::command(&a),
     }
 }
