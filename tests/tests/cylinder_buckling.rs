@@ -1,6 +1,6 @@
 //! The cylinders' rod check (`<cylinder>_rod_check`, crates/hydraulics/src/buckling.rs) in
-//! the knuckle boom crane: its outputs against hand values from the design page
-//! (docs/knuckle-boom.md: rod d_r = 0.06 m, steel E = 210 GPa, both cylinders on pins) at
+//! the knuckle boom crane: its outputs against hand values from docs/knuckle-boom.md
+//! (rod d_r = 0.06 m, steel E = 210 GPa, both cylinders on pins) at
 //! one time of the luffing run, and its cost: the right-hand side never evaluates it.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
