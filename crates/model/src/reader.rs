@@ -55,6 +55,20 @@ pub struct ElementSpec<'a> {
 /// `[parameters]` written with a unit (`p = "300 bar"`): name → (unit, its text).
 pub(crate) type ParamUnits = std::collections::HashMap<String, (units::Unit, String)>;
 
+/// A parameter's doc as the object of "it is …": "the spring rate", and a doc that starts
+/// with an article already ("the links' …", "a list of …") as it is.
+fn the(doc: &str) -> String {
+    let lower = doc.to_lowercase();
+    if ["the ", "a ", "an ", "one "]
+        .iter()
+        .any(|a| lower.starts_with(a))
+    {
+        doc.to_owned()
+    } else {
+        format!("the {doc}")
+    }
+}
+
 fn kind_of(e: &BuildError) -> ErrorKind {
     match e.kind {
         BuildErrorKind::Missing => ErrorKind::MissingParameter,
@@ -358,8 +372,10 @@ impl<'a> ElementSpec<'a> {
                 ),
             )
             .hint(format!(
-                "fix `{}` of `{}`: it is the {}",
-                d.name, self.name, d.doc
+                "fix `{}` of `{}`: it is {}",
+                d.name,
+                self.name,
+                the(d.doc)
             )))
     }
 
@@ -495,10 +511,26 @@ impl<'a> ElementSpec<'a> {
                 format!(", in {}", d.unit)
             };
             m = m.hint(format!(
-                "fix `{}` of `{}`: it is the {}{unit}",
-                d.name, self.name, d.doc
+                "fix `{}` of `{}`: it is {}{unit}",
+                d.name,
+                self.name,
+                the(d.doc)
             ));
         }
         m.with_source(e)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// The arm's hint said "it is the the link the pin is on" (issue 37, item 8).
+    #[test]
+    fn a_doc_with_its_own_article_gets_no_second_one() {
+        assert_eq!(
+            super::the("the link the pin is on, 1, 2, …"),
+            "the link the pin is on, 1, 2, …"
+        );
+        assert_eq!(super::the("spring rate"), "the spring rate");
+        assert_eq!(super::the("A list of links"), "A list of links");
     }
 }

@@ -428,7 +428,7 @@ impl Simulation {
             &mut stepper,
             &mut rec,
             t_stop,
-            self.settings.max_steps,
+            &self.settings,
             &self.limits,
             &bad,
             &mut scratch,
