@@ -145,3 +145,22 @@ fn an_integer_too_large_is_refused_at_its_line() {
     let e = m.unwrap_err();
     assert_eq!(e.line, Some(line_of(&text, "t_end")), "{e:?}");
 }
+
+#[test]
+fn an_empty_inputs_file_hints_the_header_of_this_model() {
+    let dir = tempfile::tempdir().unwrap();
+    let empty = dir.path().join("empty.csv");
+    std::fs::write(&empty, "").unwrap();
+    let (_, m) = model(dir.path(), "pump_q", "[inputs]\npump_q = 0.0");
+    let e = m
+        .unwrap()
+        .set_inputs_from_csv(
+            &empty,
+            bondgraph::Interp::Linear,
+            bg_model::Extrapolate::Error,
+        )
+        .unwrap_err();
+    let hint = e.hint.clone().unwrap_or_default();
+    assert!(hint.contains("`t,pump_q`"), "{e}");
+    assert!(!hint.contains("t,F"), "{e}");
+}

@@ -31,3 +31,35 @@ dt_out = 0.1
     assert!(e.contains("`tank.q`"), "{e}");
     assert!(!e.contains("quiet"), "{e}");
 }
+
+/// A run whose equations are not finite at t = 0 stops there: no row of NaN is written
+/// (the partial file of `bg-sim run` held `0,1,NaN`).
+#[test]
+fn a_run_that_cannot_start_writes_no_row_of_non_finite_values() {
+    let text = r#"
+[elements]
+feed  = { kind = "Sf", f = "sqrt(tank.q - 1.5)" }
+tank  = { kind = "C", c = 1.0, q0 = 1.0 }
+[bonds]
+b1 = "feed -> tank"
+[simulation]
+t_end = 1.0
+dt_out = 0.1
+[outputs]
+q = "tank.q"
+f = "b1.f"
+"#;
+    let mut m = Model::from_text("nan.toml", text, &Registry::with_core(), &[]).unwrap();
+    let (outcome, _) = m.run_checked().unwrap();
+    let e = outcome
+        .error
+        .expect("the run must fail at t = 0")
+        .to_string();
+    assert!(e.contains("not finite at the start"), "{e}");
+    assert_eq!(outcome.rows, 0, "{:?}", outcome.trajectory.rows);
+    assert!(outcome
+        .trajectory
+        .rows
+        .iter()
+        .all(|r| r.iter().all(|v| v.is_finite())));
+}

@@ -327,7 +327,18 @@ impl Model {
         extrapolate: Extrapolate,
     ) -> Result<Vec<String>, ModelError> {
         let shown = path.display().to_string();
-        let data = DataFile::read(path, &shown)?;
+        let data = DataFile::read(path, &shown).map_err(|e| {
+            if e.message.contains("no header") {
+                // the header this model's inputs would have, not an example's
+                let names: Vec<String> = self.inputs().into_iter().map(|s| s.name).collect();
+                e.hint(format!(
+                    "the first line names the columns: `t,{}`",
+                    names.join(",")
+                ))
+            } else {
+                e
+            }
+        })?;
         let times = data.times()?;
         let _ = times;
         let inputs: Vec<String> = self.inputs().into_iter().map(|s| s.name).collect();
