@@ -63,3 +63,33 @@ f = "b1.f"
         .iter()
         .all(|r| r.iter().all(|v| v.is_finite())));
 }
+
+/// Numbers in messages are short: `rtol = 1e-300` was echoed with 300 zeros.
+#[test]
+fn numbers_in_refusals_are_printed_short() {
+    let text = r#"
+[elements]
+feed  = { kind = "Sf", f = 1.0 }
+tank  = { kind = "C", c = 1.0 }
+[bonds]
+b1 = "feed -> tank"
+[simulation]
+t_end = 1.0
+rtol = 1e-300
+"#;
+    let e = Model::from_text("short.toml", text, &Registry::with_core(), &[]).unwrap_err();
+    let shown = e.to_string();
+    assert!(shown.contains("1e-300"), "{shown}");
+    assert!(!shown.contains("00000000"), "{shown}");
+    let e = Model::from_text(
+        "short.toml",
+        &text
+            .replace("rtol = 1e-300", "")
+            .replace("c = 1.0 }", "c = -1e-300 }"),
+        &Registry::with_core(),
+        &[],
+    );
+    if let Err(e) = e {
+        assert!(!e.to_string().contains("00000000"), "{e}");
+    }
+}
