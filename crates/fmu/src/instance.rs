@@ -442,6 +442,22 @@ impl Instance {
             .ok_or_else(|| Failure::error(format!("no variable has value reference {vr}")))?;
         match v.role {
             Role::Time => Ok(self.run.as_ref().map_or(self.start_time, Stepping::t)),
+            Role::Input(i) if !self.inputs_set.get(i).copied().unwrap_or(false) => {
+                // an input the importer has not set reads what drives it: its data, if any
+                let t = self.t();
+                let eqs = match (&self.run, &self.model) {
+                    (Some(r), _) => Some(r.simulation().equations()),
+                    (None, Some(m)) => Some(&m.equations),
+                    (None, None) => None,
+                };
+                let data = eqs.and_then(|e| {
+                    e.input_series(i)
+                        .ok()
+                        .flatten()
+                        .and_then(|_| e.input_value(i, t).ok())
+                });
+                Ok(data.unwrap_or(self.values[vr as usize]))
+            }
             Role::Input(_) | Role::Parameter(_) => Ok(self.values[vr as usize]),
             Role::Output(_) => {
                 self.running()?;
