@@ -111,7 +111,8 @@ fn check_lists_causality_and_refuses_bad_models() {
     ] {
         let o = bg_sim().arg("check").arg(model(name)).output().unwrap();
         let s = String::from_utf8_lossy(&o.stdout);
-        assert_eq!(o.status.code(), Some(1), "{s}");
+        // a model with problems is bad input: 2, as in every command (issue 37)
+        assert_eq!(o.status.code(), Some(2), "{s}");
         for w in words {
             assert!(s.contains(w), "`{w}` missing: {s}");
         }
@@ -258,7 +259,7 @@ fn a_deeply_nested_expression_is_an_error_not_a_stack_overflow() {
     for n in [3_000, 9_000] {
         let deep = format!("parameters.k={}10{}", "(".repeat(n), ")".repeat(n));
         let (code, out, _) = run_ok(&[os("check"), os(&m), os("--set"), os(&deep)]);
-        assert_eq!(code, 1, "{out}");
+        assert_eq!(code, 2, "{out}");
         assert!(
             out.contains("nested more than 200") || out.contains("more than 10000"),
             "{out}"

@@ -40,7 +40,7 @@ fn check_json_lists_the_problem_with_its_line_and_hint() {
         "--format".as_ref(),
         "json".as_ref(),
     ]);
-    assert_eq!(code, 1, "{v:#}");
+    assert_eq!(code, 2, "{v:#}");
     assert_eq!(v["ok"], false);
     let problems = v["problems"].as_array().unwrap();
     assert_eq!(problems.len(), 1, "{v:#}");
@@ -134,7 +134,7 @@ fn check_json_lists_every_problem_of_a_file_with_two_independent_mistakes() {
         "json".as_ref(),
     ]);
     std::fs::remove_dir_all(&dir).ok();
-    assert_eq!(code, 1, "{v:#}");
+    assert_eq!(code, 2, "{v:#}");
     let problems = v["problems"].as_array().unwrap();
     assert_eq!(problems.len(), 2, "{v:#}");
     let by_element = |e: &str| {

@@ -120,7 +120,7 @@ fn check_of_an_unreadable_model_is_bad_input() {
     let bad = dir.path().join("bad.toml");
     std::fs::write(&bad, "[elements]\nm = { kind = \"I\" }\n").unwrap();
     let o = within(bg_sim().arg("check").arg(&bad)).unwrap();
-    assert_eq!(o.status.code(), Some(1), "{o:?}");
+    assert_eq!(o.status.code(), Some(2), "{o:?}");
 }
 
 /// A FIFO (or a directory) given where a results CSV, a sweep spec or a sweep summary is

@@ -198,7 +198,7 @@ pub unsafe extern "C" fn fmi2SetupExperiment(
                 &format!("tolerance {tolerance} ignored: the model's own [simulation] rtol/atol are used (change them with `bg-sim fmu --set`)"),
             );
         }
-        i.setup(start_time);
+        i.setup_checked("fmi2SetupExperiment", start_time)?;
         Ok(Status::Ok)
     })
 }
@@ -210,7 +210,10 @@ pub unsafe extern "C" fn fmi2SetupExperiment(
 #[no_mangle]
 pub unsafe extern "C" fn fmi2EnterInitializationMode(c: *mut c_void) -> c_int {
     // SAFETY: `c` is null or live (the caller's contract).
-    run(unsafe { instance(c) }, |_| Ok(Status::Ok))
+    run(unsafe { instance(c) }, |i| {
+        i.enter_init("fmi2EnterInitializationMode")
+            .map(|()| Status::Ok)
+    })
 }
 
 /// `fmi2ExitInitializationMode`: the run starts.
@@ -221,7 +224,8 @@ pub unsafe extern "C" fn fmi2EnterInitializationMode(c: *mut c_void) -> c_int {
 pub unsafe extern "C" fn fmi2ExitInitializationMode(c: *mut c_void) -> c_int {
     // SAFETY: `c` is null or live (the caller's contract).
     run(unsafe { instance(c) }, |i| {
-        i.exit_init().map(|()| Status::Ok)
+        i.exit_init("fmi2ExitInitializationMode")
+            .map(|()| Status::Ok)
     })
 }
 
@@ -232,7 +236,9 @@ pub unsafe extern "C" fn fmi2ExitInitializationMode(c: *mut c_void) -> c_int {
 #[no_mangle]
 pub unsafe extern "C" fn fmi2Terminate(c: *mut c_void) -> c_int {
     // SAFETY: `c` is null or live (the caller's contract).
-    run(unsafe { instance(c) }, |_| Ok(Status::Ok))
+    run(unsafe { instance(c) }, |i| {
+        i.terminate("fmi2Terminate").map(|()| Status::Ok)
+    })
 }
 
 /// `fmi2Reset`.
@@ -441,6 +447,6 @@ pub unsafe extern "C" fn fmi2DoStep(
 ) -> c_int {
     // SAFETY: `c` is null or live (the caller's contract).
     run(unsafe { instance(c) }, |i| {
-        i.do_step(t, h).map(|()| Status::Ok)
+        i.do_step("fmi2DoStep", t, h).map(|()| Status::Ok)
     })
 }

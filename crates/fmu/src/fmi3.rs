@@ -174,7 +174,8 @@ pub unsafe extern "C" fn fmi3EnterInitializationMode(
                 &format!("tolerance {tolerance} ignored: the model's own [simulation] rtol/atol are used (change them with `bg-sim fmu --set`)"),
             );
         }
-        i.setup(start_time);
+        i.setup_checked("fmi3EnterInitializationMode", start_time)?;
+        i.enter_init("fmi3EnterInitializationMode")?;
         Ok(Status::Ok)
     })
 }
@@ -187,7 +188,8 @@ pub unsafe extern "C" fn fmi3EnterInitializationMode(
 pub unsafe extern "C" fn fmi3ExitInitializationMode(c: *mut c_void) -> c_int {
     // SAFETY: `c` is null or live (the caller's contract).
     run(unsafe { instance(c) }, |i| {
-        i.exit_init().map(|()| Status::Ok)
+        i.exit_init("fmi3ExitInitializationMode")
+            .map(|()| Status::Ok)
     })
 }
 
@@ -208,7 +210,9 @@ pub unsafe extern "C" fn fmi3EnterStepMode(c: *mut c_void) -> c_int {
 #[no_mangle]
 pub unsafe extern "C" fn fmi3Terminate(c: *mut c_void) -> c_int {
     // SAFETY: `c` is null or live (the caller's contract).
-    run(unsafe { instance(c) }, |_| Ok(Status::Ok))
+    run(unsafe { instance(c) }, |i| {
+        i.terminate("fmi3Terminate").map(|()| Status::Ok)
+    })
 }
 
 /// `fmi3Reset`.
@@ -300,7 +304,7 @@ pub unsafe extern "C" fn fmi3DoStep(
 ) -> c_int {
     // SAFETY: `c` is null or live (the caller's contract).
     run(unsafe { instance(c) }, |i| {
-        let r = i.do_step(t, h);
+        let r = i.do_step("fmi3DoStep", t, h);
         let now = i.t();
         for (p, v) in [
             (event_handling_needed, 0),

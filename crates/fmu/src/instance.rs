@@ -84,6 +84,9 @@ pub struct Snapshot {
     params_set: bool,
 }
 
+mod phase;
+pub use phase::Phase;
+
 /// One instance of the FMU; see the module doc.
 pub struct Instance {
     name: String,
@@ -111,6 +114,8 @@ pub struct Instance {
     start_time: f64,
     /// After a failed step, nothing but reset, a saved state or free.
     failed: bool,
+    /// Where it is in the FMI state machine.
+    phase: Phase,
 }
 
 impl std::fmt::Debug for Instance {
@@ -214,6 +219,7 @@ impl Instance {
             params_set: false,
             start_time,
             failed: false,
+            phase: Phase::Instantiated,
         })
     }
 
@@ -333,14 +339,6 @@ impl Instance {
         )?)
     }
 
-    /// End of initialisation: the run starts (if it has not).
-    ///
-    /// # Errors
-    /// The model failing to start (a limit crossed, a state not finite).
-    pub fn exit_init(&mut self) -> Result<(), Failure> {
-        self.running().map(|_| ())
-    }
-
     /// The value of variable `vr`.
     ///
     /// # Errors
@@ -352,6 +350,22 @@ impl Instance {
             .ok_or_else(|| Failure::error(format!("no variable has value reference {vr}")))?;
         match v.role {
             Role::Time => Ok(self.run.as_ref().map_or(self.start_time, Stepping::t)),
+            Role::Input(i) if !self.inputs_set.get(i).copied().unwrap_or(false) => {
+                // an input the importer has not set reads what drives it: its data, if any
+                let t = self.t();
+                let eqs = match (&self.run, &self.model) {
+                    (Some(r), _) => Some(r.simulation().equations()),
+                    (None, Some(m)) => Some(&m.equations),
+                    (None, None) => None,
+                };
+                let data = eqs.and_then(|e| {
+                    e.input_series(i)
+                        .ok()
+                        .flatten()
+                        .and_then(|_| e.input_value(i, t).ok())
+                });
+                Ok(data.unwrap_or(self.values[vr as usize]))
+            }
             Role::Input(_) | Role::Parameter(_) => Ok(self.values[vr as usize]),
             Role::Output(_) => {
                 self.running()?;
@@ -449,7 +463,8 @@ impl Instance {
     /// # Errors
     /// `t` not the current time, `h` negative, the run failing on the way (the instance
     /// then refuses to go on until reset or set to a saved state).
-    pub fn do_step(&mut self, t: f64, h: f64) -> Result<(), Failure> {
+    pub fn do_step(&mut self, call: &str, t: f64, h: f64) -> Result<(), Failure> {
+        self.require(call, &[Phase::Stepping])?;
         if !(h.is_finite() && h >= 0.0 && t.is_finite()) {
             return Err(Failure::error(format!(
                 "step from {t} by {h}: both must be finite and the step ≥ 0"
@@ -477,6 +492,7 @@ impl Instance {
     /// # Errors
     /// The model failing to load again.
     pub fn reset(&mut self) -> Result<(), Failure> {
+        self.phase = Phase::Instantiated;
         self.run = None;
         self.failed = false;
         self.params_set = false;

@@ -28,5 +28,5 @@ pub mod instance;
 pub mod package;
 
 pub use description::{Description, FmiVersion};
-pub use instance::{Instance, Status};
+pub use instance::{Instance, Phase, Status};
 pub use package::{export, ExportError, Exported};

@@ -73,6 +73,8 @@ impl DataFile {
     /// # Errors
     /// A [`ModelError`] at the line and column of the first bad cell.
     pub fn parse(text: &str, file: &str) -> Result<Self, ModelError> {
+        // a byte-order mark before the header (spreadsheets write one) is not a name
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let mut rows = text
             .lines()
             .enumerate()

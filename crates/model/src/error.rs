@@ -140,7 +140,16 @@ impl fmt::Display for ModelError {
         }
         write!(f, ": ")?;
         if let Some(e) = &self.element {
-            write!(f, "element `{e}`: ")?;
+            // an input or a table is not an element; its messages may name it already
+            let word = match self.kind {
+                ErrorKind::Input => "input",
+                ErrorKind::Table => "table",
+                _ => "element",
+            };
+            let named = format!("{word} `{e}`");
+            if !self.message.starts_with(&named) {
+                write!(f, "{named}: ")?;
+            }
         }
         write!(f, "{}", self.message)?;
         if let Some(h) = &self.hint {
@@ -244,6 +253,36 @@ pub(crate) fn line_col(text: &str, offset: usize) -> (usize, usize) {
         .map_or(before.chars().count(), |i| before[i + 1..].chars().count())
         + 1;
     (line, col)
+}
+
+/// Byte offset of the first value `= 123…` whose digits do not fit an i64 (TOML integers).
+pub(crate) fn too_large_integer(text: &str) -> Option<usize> {
+    let mut offset = 0;
+    for line in text.split_inclusive('\n') {
+        if let Some(eq) = line.find('=') {
+            let value = &line[eq + 1..];
+            let lead = value.len() - value.trim_start().len();
+            let v = value.trim_start();
+            let digits: String = v
+                .chars()
+                .take_while(|c| c.is_ascii_digit() || matches!(c, '+' | '-' | '_'))
+                .filter(|c| *c != '_')
+                .collect();
+            let rest = &v[v
+                .char_indices()
+                .find(|(_, c)| !(c.is_ascii_digit() || matches!(c, '+' | '-' | '_')))
+                .map_or(v.len(), |(i, _)| i)..];
+            let float = rest.starts_with(['.', 'e', 'E']);
+            if !float
+                && digits.chars().any(|c| c.is_ascii_digit())
+                && digits.parse::<i64>().is_err()
+            {
+                return Some(offset + eq + 1 + lead);
+            }
+        }
+        offset += line.len();
+    }
+    None
 }
 
 #[cfg(test)]

@@ -48,6 +48,25 @@ pub struct ElementSpec<'a> {
     pub(crate) inputs: &'a [String],
     /// The model's `[tables]`, callable in expressions.
     pub(crate) tables: Arc<Tables>,
+    /// The `[parameters]` written with a unit: its unit and how it was written.
+    pub(crate) param_units: Arc<ParamUnits>,
+}
+
+/// `[parameters]` written with a unit (`p = "300 bar"`): name → (unit, its text).
+pub(crate) type ParamUnits = std::collections::HashMap<String, (units::Unit, String)>;
+
+/// A parameter's doc as the object of "it is …": "the spring rate", and a doc that starts
+/// with an article already ("the links' …", "a list of …") as it is.
+fn the(doc: &str) -> String {
+    let lower = doc.to_lowercase();
+    if ["the ", "a ", "an ", "one "]
+        .iter()
+        .any(|a| lower.starts_with(a))
+    {
+        doc.to_owned()
+    } else {
+        format!("the {doc}")
+    }
 }
 
 fn kind_of(e: &BuildError) -> ErrorKind {
@@ -85,6 +104,7 @@ impl<'a> ElementSpec<'a> {
             used_constants,
             inputs: &[],
             tables: Arc::new(Tables::default()),
+            param_units: Arc::default(),
         }
     }
 
@@ -214,36 +234,31 @@ impl<'a> ElementSpec<'a> {
             toml::Value::String(s) => {
                 if let Some((body, unit)) = units::split_value(s) {
                     if let Ok(e) = Expr::parse_with(body, &self.tables.signatures()) {
-                        let Some(want) = units::parse(d.unit) else {
-                            return Err(self.err(BuildErrorKind::WrongUnit, key, format!("`{key}` is given with a unit, but its unit `{}` cannot be converted", d.unit))
-                                .hint(format!("write `{key}` as a number in {}", d.unit)));
-                        };
-                        if want.dim != unit.dim {
-                            return Err(self
-                                .err(
-                                    BuildErrorKind::WrongUnit,
-                                    key,
-                                    format!(
-                                        "`{key}` is a {} ({}), but \"{}\" is a {}",
-                                        units::describe(want.dim),
-                                        d.unit,
-                                        clip(s),
-                                        units::describe(unit.dim)
-                                    ),
-                                )
-                                .hint(format!(
-                                    "give `{key}` in {} or a unit of the same kind",
-                                    d.unit
-                                )));
-                        }
-                        let scale = unit.scale / want.scale;
+                        let text = units::split_last(s).map_or("", |(_, u)| u);
+                        let scale = self.convert(d, s, body, text, unit)?;
                         return Ok(Expr::Bin('*', Box::new(Expr::Num(scale)), Box::new(e)));
                     }
                 }
-                Expr::parse_with(s, &self.tables.signatures()).map_err(|e| {
+                let e = Expr::parse_with(s, &self.tables.signatures()).map_err(|e| {
+                    // a known expression followed by a word that is no unit: name the unit
+                    if let Some((body, word)) = units::split_last(s) {
+                        if Expr::parse_with(body, &self.tables.signatures()).is_ok() {
+                            let (message, hint) = units::why_not(word);
+                            return self
+                                .err(BuildErrorKind::WrongUnit, key, format!("`{key}` = \"{}\": {message}", clip(s)))
+                                .hint(hint);
+                        }
+                    }
                     self.err(BuildErrorKind::Invalid, key, format!("cannot read `{key}` = \"{}\": {e}", clip(s)))
                         .hint("expressions use numbers, parameters, signals like `spring.q`, `t`, + - * / ^ and functions such as sqrt, sin, exp, min, max; a unit may follow after a space (\"200 bar\")")
-                })
+                })?;
+                // a bare [parameters] name written with a unit keeps its unit's check
+                if let Expr::Name(n) = &e {
+                    if let Some(&(unit, ref text)) = self.param_units.get(n) {
+                        self.convert(d, s, n, text, unit)?;
+                    }
+                }
+                Ok(e)
             }
             other => Err(self.err(
                 BuildErrorKind::Invalid,
@@ -254,6 +269,55 @@ impl<'a> ElementSpec<'a> {
                 ),
             )),
         }
+    }
+
+    /// The factor from `unit` (written `text` after `body` in `s`) to `d`'s declared unit, or
+    /// why it does not convert. A parameter declared without a unit (a core kind's, whose
+    /// bonds decide it) takes any unit, converted to SI.
+    fn convert(
+        &self,
+        d: &ParamDecl,
+        s: &str,
+        body: &str,
+        text: &str,
+        unit: units::Unit,
+    ) -> Result<f64, BuildError> {
+        let key = d.name;
+        if d.unit.is_empty() {
+            return Ok(unit.scale);
+        }
+        let Some(want) = units::parse(d.unit) else {
+            return Err(self
+                .err(
+                    BuildErrorKind::WrongUnit,
+                    key,
+                    format!(
+                        "`{key}` is given with a unit, but its unit `{}` cannot be converted",
+                        d.unit
+                    ),
+                )
+                .hint(format!("write `{key}` as a number in {}", d.unit)));
+        };
+        if want.dim == unit.dim {
+            return Ok(unit.scale / want.scale);
+        }
+        let what = units::name(want.dim).map_or_else(
+            || format!("quantity in {}", d.unit),
+            |n| format!("{n} ({})", d.unit),
+        );
+        let hint = units::angle_hint(body, text, want, unit)
+            .unwrap_or_else(|| format!("give `{key}` in {} or a unit of the same kind", d.unit));
+        Err(self
+            .err(
+                BuildErrorKind::WrongUnit,
+                key,
+                format!(
+                    "`{key}` is a {what}, but \"{}\" is a {}",
+                    clip(s),
+                    units::describe(unit.dim)
+                ),
+            )
+            .hint(hint))
     }
 
     fn note_constants(&self, e: &Expr) {
@@ -301,13 +365,17 @@ impl<'a> ElementSpec<'a> {
                 BuildErrorKind::Invalid,
                 d.name,
                 format!(
-                    "`{}` = {v} is out of range: it must be {}{unit}",
-                    d.name, d.range
+                    "`{}` = {} is out of range: it must be {}{unit}",
+                    d.name,
+                    units::short(v),
+                    d.range
                 ),
             )
             .hint(format!(
-                "fix `{}` of `{}`: it is the {}",
-                d.name, self.name, d.doc
+                "fix `{}` of `{}`: it is {}",
+                d.name,
+                self.name,
+                the(d.doc)
             )))
     }
 
@@ -414,6 +482,7 @@ impl<'a> ElementSpec<'a> {
             used_constants: self.used_constants,
             inputs: self.inputs,
             tables: Arc::clone(&self.tables),
+            param_units: Arc::clone(&self.param_units),
         };
         spec.validate()?;
         Ok(Box::new(spec))
@@ -442,10 +511,26 @@ impl<'a> ElementSpec<'a> {
                 format!(", in {}", d.unit)
             };
             m = m.hint(format!(
-                "fix `{}` of `{}`: it is the {}{unit}",
-                d.name, self.name, d.doc
+                "fix `{}` of `{}`: it is {}{unit}",
+                d.name,
+                self.name,
+                the(d.doc)
             ));
         }
         m.with_source(e)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// The arm's hint said "it is the the link the pin is on" (issue 37, item 8).
+    #[test]
+    fn a_doc_with_its_own_article_gets_no_second_one() {
+        assert_eq!(
+            super::the("the link the pin is on, 1, 2, …"),
+            "the link the pin is on, 1, 2, …"
+        );
+        assert_eq!(super::the("spring rate"), "the spring rate");
+        assert_eq!(super::the("A list of links"), "A list of links");
     }
 }

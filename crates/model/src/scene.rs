@@ -134,7 +134,11 @@ pub(crate) fn read(
         Ok(d) => d,
         Err(e) => {
             let e: toml_edit::TomlError = e;
-            return Err(err(None, e.message().to_owned()));
+            // an integer past i64 has no span from the parser: find it
+            let at = e
+                .span()
+                .or_else(|| crate::error::too_large_integer(text).map(|a| a..a + 1));
+            return Err(err(at.as_ref(), e.message().to_owned()));
         }
     };
     for (name, v) in table {

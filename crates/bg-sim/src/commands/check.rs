@@ -9,7 +9,7 @@ use bg_sim::registry;
 use serde_json::json;
 
 use super::json::{problems, Format};
-use super::{BAD_INPUT, FAILED};
+use super::BAD_INPUT;
 
 /// The options of `bg-sim check` (its summary is on `Command::Check` in main.rs).
 #[derive(clap::Args)]
@@ -67,15 +67,13 @@ fn check_json(path: &Path, set: &[String]) -> ExitCode {
     status(&report.problems)
 }
 
-/// 0 without problems; 2 if the model could not be read (a missing or unreadable file, a
-/// directory, a FIFO: bad input, nothing was checked); else 1, problems found.
+/// 0 without problems; else 2: a model with problems is bad input, as for every command
+/// (an unreadable file and a wrong parameter alike; docs/limits.md, "Exit statuses").
 fn status(problems: &[bg_model::ModelError]) -> ExitCode {
     if problems.is_empty() {
         ExitCode::SUCCESS
-    } else if problems.iter().any(|p| p.kind == bg_model::ErrorKind::Io) {
-        ExitCode::from(BAD_INPUT)
     } else {
-        ExitCode::from(FAILED)
+        ExitCode::from(BAD_INPUT)
     }
 }
 

@@ -199,15 +199,7 @@ pub(super) fn run_radau(
         t_stop,
         limits: &limits,
     };
-    let result = drive(
-        &mut stepper,
-        rec,
-        t_stop,
-        settings.max_steps,
-        &limits,
-        bad,
-        stats,
-    );
+    let result = drive(&mut stepper, rec, t_stop, settings, &limits, bad, stats);
     stats.rhs_evals += stepper.sys.rhs_calls;
     stats.jac_evals += stepper.sys.jac_calls;
     stats.jac_assemblies += stepper.sys.jac_calls;

@@ -173,9 +173,12 @@ pub fn simulate_audited(
         if switched && wants_steps && t > t0 {
             rec.step_values(t, &x);
         }
-        // Rows due at the current time (after the events).
-        while rec.pending().is_some_and(|g| same_time(g, t)) {
-            rec.record(t, &x);
+        // Rows due at the current time (after the events) — none where the equations are not
+        // finite: the segment refuses to start there, and the row would be NaN.
+        if rec.pending().is_some_and(|g| same_time(g, t)) && finite_at(rec.eqs, t, &x) {
+            while rec.pending().is_some_and(|g| same_time(g, t)) {
+                rec.record(t, &x);
+            }
         }
         let seg = if t >= t_end || same_time(t, t_end) {
             None
@@ -248,6 +251,16 @@ fn record_without_states(rec: &mut Recorder<'_>, t_stop: f64) -> Result<Vec<f64>
 }
 
 pub(super) type SegmentError = (f64, Vec<f64>, SimulationError);
+
+/// Whether the equations are finite at (t, x) (always, without states: nothing to refuse).
+fn finite_at(eqs: &StateEquations, t: f64, x: &[f64]) -> bool {
+    if x.is_empty() {
+        return true;
+    }
+    let mut dx = vec![0.0; x.len()];
+    eqs.rhs(t, x, &mut dx);
+    dx.iter().all(|v| v.is_finite())
+}
 
 pub(super) fn culprit(eqs: &StateEquations, bad: &RefCell<Option<(f64, Vec<f64>)>>) -> String {
     bad.borrow()

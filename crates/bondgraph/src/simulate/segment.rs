@@ -153,7 +153,7 @@ pub(super) fn run_segment(
             s.as_mut(),
             rec,
             t_stop,
-            settings.max_steps,
+            settings,
             &limits,
             &bad,
             stats,

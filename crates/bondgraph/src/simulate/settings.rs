@@ -124,6 +124,7 @@ fn time_resolution(s: &Settings) -> f64 {
 impl Settings {
     /// Check the settings make sense.
     pub fn validate(&self) -> Result<(), SimulationError> {
+        use crate::kind::units::short;
         let bad = |setting, message: String| {
             Err(SimulationError::InvalidSetting {
                 setting,
@@ -136,14 +137,15 @@ impl Settings {
                 "t_end",
                 format!(
                     "need finite t_start < t_end, got t_start = {}, t_end = {}",
-                    self.t_start, self.t_end
+                    short(self.t_start),
+                    short(self.t_end)
                 ),
             );
         }
         if !(self.dt_out.is_finite() && self.dt_out > 0.0) {
             return bad(
                 "dt_out",
-                format!("must be finite and > 0, got {}", self.dt_out),
+                format!("must be finite and > 0, got {}", short(self.dt_out)),
             );
         }
         let res = time_resolution(self);
@@ -182,11 +184,14 @@ impl Settings {
         if !(self.rtol.is_finite() && (MIN_RTOL..1.0).contains(&self.rtol)) {
             return bad(
                 "rtol",
-                format!("must be in [{MIN_RTOL:e}, 1), got {}", self.rtol),
+                format!("must be in [{MIN_RTOL:e}, 1), got {}", short(self.rtol)),
             );
         }
         if !(self.atol.is_finite() && self.atol > 0.0) {
-            return bad("atol", format!("must be finite and > 0, got {}", self.atol));
+            return bad(
+                "atol",
+                format!("must be finite and > 0, got {}", short(self.atol)),
+            );
         }
         Ok(())
     }

@@ -6,6 +6,7 @@ use std::cell::RefCell;
 use diffsol::{OdeEquations, OdeSolverMethod, OdeSolverStopReason};
 
 use super::{culprit, same_time, Bound, Recorder, SegmentError, Statistics};
+use crate::equations::StateEquations;
 use crate::error::SimulationError;
 
 /// How a step ended.
@@ -110,12 +111,13 @@ pub(super) fn drive(
     s: &mut dyn Stepper,
     rec: &mut Recorder<'_>,
     t_stop: f64,
-    max_steps: usize,
+    settings: &super::Settings,
     limits: &[Bound],
     bad: &RefCell<Option<(f64, Vec<f64>)>>,
     stats: &mut Statistics,
 ) -> Result<Vec<f64>, SegmentError> {
     let eqs = rec.eqs;
+    let max_steps = settings.max_steps;
     let finish = |s: &dyn Stepper, stats: &mut Statistics| {
         let w = s.work();
         stats.steps += w.steps;
@@ -143,7 +145,13 @@ pub(super) fn drive(
         if stalled || too_many {
             finish(s, stats);
             let (message, hint) = if stalled {
-                (format!("the step size collapsed to {h:e}"), None)
+                (
+                    format!(
+                        "the step size collapsed to {h:e}{}",
+                        fastest(eqs, t, &x, settings)
+                    ),
+                    Some("the state named changes fastest for its tolerance: look at what drives it (a stiff or singular term, a value that blows up, an event the model needs)"),
+                )
             } else {
                 (
                     format!("more than {max_steps} steps"),
@@ -187,6 +195,30 @@ pub(super) fn drive(
         }
         t_prev = t;
     }
+}
+
+/// The state with the largest weighted rate |dx/dt|/(atol + rtol·|x|) at (t, x) — the one
+/// whose local error bounds the step where the step size collapses — as "; fastest state
+/// `name` (x = …, dx/dt = …)"; empty if the rates are not finite. Evaluated once, at the
+/// failure.
+fn fastest(eqs: &StateEquations, t: f64, x: &[f64], s: &super::Settings) -> String {
+    if x.is_empty() || x.iter().any(|v| !v.is_finite()) {
+        return String::new();
+    }
+    let mut dx = vec![0.0; x.len()];
+    eqs.rhs(t, x, &mut dx);
+    let weighted = |k: usize| dx[k].abs() / (s.atol + s.rtol * x[k].abs());
+    let Some(k) = (0..x.len())
+        .filter(|&k| weighted(k).is_finite())
+        .max_by(|&a, &b| weighted(a).total_cmp(&weighted(b)))
+    else {
+        return String::new();
+    };
+    let name = eqs.states().get(k).map_or("?", |s| s.name.as_str());
+    format!(
+        "; fastest state for its tolerance: `{name}` (x = {:e}, dx/dt = {:e})",
+        x[k], dx[k]
+    )
 }
 
 fn solver_error(t: f64, message: String, culprit: String) -> SimulationError {

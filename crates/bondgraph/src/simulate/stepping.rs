@@ -344,6 +344,9 @@ impl Simulation {
         loop {
             let t = self.t();
             if same_time(t, t_target) || t >= t_target {
+                // what is read here sees the inputs as a run's row at t does: a series on
+                // the piece holding t (at a sample of a held series, the value from t on)
+                self.eqs.begin_segment(t);
                 return Ok(());
             }
             let next_event = self.events.last().map(|e| e.t);
@@ -428,7 +431,7 @@ impl Simulation {
             &mut stepper,
             &mut rec,
             t_stop,
-            self.settings.max_steps,
+            &self.settings,
             &self.limits,
             &bad,
             &mut scratch,

@@ -251,15 +251,17 @@ pub(super) fn apply_files(
 ) {
     for d in &source.inputs {
         let Some(r) = &d.data else { continue };
-        let at = |e: ModelError| {
-            let mut e = e;
-            if e.element.is_none() {
-                e = e.element(&d.spec.name);
-            }
-            e
-        };
         let path = relative(&source.file, &r.file);
         let shown = path.display().to_string();
+        let what = format!("input `{}`", d.spec.name);
+        let header = format!("t,{}", r.column);
+        let at = |e: ModelError| {
+            if e.kind == ErrorKind::Input {
+                e
+            } else {
+                source.data_err(ErrorKind::Input, &d.span, &what, &shown, e, &header)
+            }
+        };
         let result = DataFile::read(&path, &shown).and_then(|data| {
             let k = data.column(&r.column).ok_or_else(|| {
                 source
@@ -325,7 +327,18 @@ impl Model {
         extrapolate: Extrapolate,
     ) -> Result<Vec<String>, ModelError> {
         let shown = path.display().to_string();
-        let data = DataFile::read(path, &shown)?;
+        let data = DataFile::read(path, &shown).map_err(|e| {
+            if e.message.contains("no header") {
+                // the header this model's inputs would have, not an example's
+                let names: Vec<String> = self.inputs().into_iter().map(|s| s.name).collect();
+                e.hint(format!(
+                    "the first line names the columns: `t,{}`",
+                    names.join(",")
+                ))
+            } else {
+                e
+            }
+        })?;
         let times = data.times()?;
         let _ = times;
         let inputs: Vec<String> = self.inputs().into_iter().map(|s| s.name).collect();

@@ -111,7 +111,17 @@ impl Parsed {
 }
 
 fn syntax(file: &str, text: &str, e: &toml::de::Error) -> ModelError {
-    let pos = e.span().map(|s| line_col(text, s.start));
+    let pos = e
+        .span()
+        .map(|s| s.start)
+        .or_else(|| {
+            // the parser names no place for an integer past i64: find the first one
+            e.message()
+                .contains("overflow")
+                .then(|| crate::error::too_large_integer(text))
+                .flatten()
+        })
+        .map(|at| line_col(text, at));
     let mut message = e.message().trim().to_owned();
     if let Some(s) = e.span() {
         // name the key or value the parser stopped at
@@ -256,6 +266,7 @@ pub(super) fn parse(
         text: text.clone(),
         registry: registry.clone(),
         param_exprs: IndexMap::new(),
+        param_units: std::sync::Arc::default(),
         elements: Vec::new(),
         events: Vec::new(),
         changed_lines,
@@ -263,6 +274,7 @@ pub(super) fn parse(
         inputs: Vec::new(),
         tables: std::sync::Arc::default(),
         line_starts: super::source::line_starts(&text),
+        index: std::sync::OnceLock::new(),
     };
     let mut problems = Vec::new();
     let mut failed = Failed::default();
@@ -280,6 +292,7 @@ pub(super) fn parse(
         }
         source.param_exprs.insert(k.get_ref().clone(), raw(v));
     }
+    source.param_units = std::sync::Arc::new(source.units_of_parameters());
     let (parameters, errors, failed_params) = source.evaluate_all(&IndexMap::new());
     problems.extend(errors);
     failed.params.extend(failed_params);

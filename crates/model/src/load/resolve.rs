@@ -11,6 +11,7 @@ use super::source::Source;
 use crate::error::{clip, ErrorKind, ModelError};
 use crate::expr::Expr;
 use crate::reader::RawValue;
+use bondgraph::kind::units;
 
 /// A parameter being evaluated: its expression, the names it uses and the next to look at.
 struct PendingParam {
@@ -23,7 +24,33 @@ struct PendingParam {
 /// Why a parameter has no value: its own problem, or one reported already.
 type Failure = Option<ModelError>;
 
+/// `"300 bar"`: the expression converted to SI (`1e5 * 300`), the unit and its text; `None`
+/// for a value without a unit.
+fn with_unit(s: &str) -> Option<(Expr, units::Unit, &str)> {
+    let (body, unit) = units::split_value(s)?;
+    let e = Expr::parse(body).ok()?;
+    let text = units::split_last(s).map_or("", |(_, u)| u);
+    Some((
+        Expr::Bin('*', Box::new(Expr::Num(unit.scale)), Box::new(e)),
+        unit,
+        text,
+    ))
+}
+
 impl Source {
+    /// The `[parameters]` written with a unit: name → (unit, its text).
+    pub(super) fn units_of_parameters(&self) -> crate::reader::ParamUnits {
+        self.param_exprs
+            .iter()
+            .filter_map(|(k, raw)| match &raw.value {
+                toml::Value::String(s) => {
+                    with_unit(s).map(|(_, u, text)| (k.clone(), (u, text.to_owned())))
+                }
+                _ => None,
+            })
+            .collect()
+    }
+
     /// Every named parameter, with `set` overriding some expressions; the first problem.
     pub(super) fn evaluate_parameters(
         &self,
@@ -73,13 +100,29 @@ impl Source {
         let expr = match &raw.value {
             toml::Value::Float(v) => Expr::Num(*v),
             toml::Value::Integer(i) => Expr::Num(*i as f64),
-            toml::Value::String(s) => Expr::parse(s).map_err(|e| {
-                self.err(
-                    ErrorKind::BadParameter,
-                    Some(&raw.span),
-                    format!("parameter `{name}` = \"{}\": {e}", clip(s)),
-                )
-            })?,
+            toml::Value::String(s) => with_unit(s).map_or_else(
+                || {
+                    Expr::parse(s).map_err(|e| {
+                        let e = self.err(
+                            ErrorKind::BadParameter,
+                            Some(&raw.span),
+                            format!("parameter `{name}` = \"{}\": {e}", clip(s)),
+                        );
+                        // a number or expression followed by a word that is no unit
+                        match units::split_last(s) {
+                            Some((body, word)) if Expr::parse(body).is_ok() => {
+                                let (message, hint) = units::why_not(word);
+                                let mut e = e.hint(hint);
+                                e.message =
+                                    format!("parameter `{name}` = \"{}\": {message}", clip(s));
+                                e
+                            }
+                            _ => e,
+                        }
+                    })
+                },
+                |(e, _, _)| Ok(e),
+            )?,
             other => {
                 return Err(self.err(
                     ErrorKind::BadParameter,

@@ -40,6 +40,9 @@ pub(super) struct Source {
     pub(super) text: String,
     pub(super) registry: Registry,
     pub(super) param_exprs: IndexMap<String, RawValue>,
+    /// The `[parameters]` written with a unit (`p = "300 bar"`), for the checks of the
+    /// element parameters that use them by name.
+    pub(super) param_units: std::sync::Arc<crate::reader::ParamUnits>,
     pub(super) elements: Vec<ElementDef>,
     pub(super) events: Vec<EventDef>,
     /// Lines (1-based) that `--set` wrote or changed: errors there say so.
@@ -53,6 +56,10 @@ pub(super) struct Source {
     /// Byte offset of each line's start in `text`: an error's line by binary search, so
     /// that refusing N mistakes is linear in N (issue 24, item 7), not N scans of the text.
     pub(super) line_starts: Vec<usize>,
+    /// Entry index by entry name and by member name, built on the first look-up (after the
+    /// entries are built): finding a name is O(1), so loading is linear in the model's size
+    /// (issue 37, item 8). A name it misses is looked for by a scan.
+    pub(super) index: std::sync::OnceLock<std::collections::HashMap<String, usize>>,
 }
 
 /// Byte offsets of the starts of the lines of `text`.
@@ -78,15 +85,66 @@ impl Source {
     /// Line and column of the entry that defines element `name` (or a member of it, or
     /// the `[inputs]` entry of that name).
     pub(super) fn element_pos(&self, name: &str) -> Option<(usize, usize)> {
-        self.elements
-            .iter()
-            .find(|e| e.name == name || e.members.iter().any(|m| m == name))
+        self.entry_of(name)
             .map(|e| self.line_col(e.name_span.start))
             .or_else(|| {
                 self.inputs
                     .iter()
                     .find(|d| d.spec.name == name)
                     .map(|d| self.line_col(d.span.start))
+            })
+    }
+
+    /// An error reading the data file `shown` that `what` (`table \`tb\``, `input \`F\``,
+    /// written at `span`) names: one without a line of the data file (missing, empty, a
+    /// directory) is placed at `span` in the model, naming the data file; one inside it
+    /// (a bad cell) stays at its line there, saying whose data it is. `columns` is the
+    /// header to suggest for an empty file.
+    pub(super) fn data_err(
+        &self,
+        kind: ErrorKind,
+        span: &Range<usize>,
+        what: &str,
+        shown: &str,
+        e: ModelError,
+        columns: &str,
+    ) -> ModelError {
+        if e.line.is_some() {
+            let mut e = e;
+            e.message = format!("{what}: {}", e.message);
+            return e;
+        }
+        let message = match e.message.strip_prefix("cannot read the data file") {
+            Some(rest) => format!("{what}: cannot read the data file `{shown}`{rest}"),
+            None => format!("{what}: the data file `{shown}` {}", e.message),
+        };
+        let hint = if e.message.contains("no header") {
+            Some(format!("the first line names the columns: `{columns}`"))
+        } else {
+            e.hint
+        };
+        self.err(kind, Some(span), message).or_hint(hint)
+    }
+
+    /// The entry called `name`, or whose member is called `name`.
+    pub(super) fn entry_of(&self, name: &str) -> Option<&ElementDef> {
+        let index = self.index.get_or_init(|| {
+            let mut m = std::collections::HashMap::with_capacity(self.elements.len());
+            for (i, e) in self.elements.iter().enumerate() {
+                m.entry(e.name.clone()).or_insert(i);
+                for n in &e.members {
+                    m.entry(n.clone()).or_insert(i);
+                }
+            }
+            m
+        });
+        index
+            .get(name)
+            .and_then(|&i| self.elements.get(i))
+            .or_else(|| {
+                self.elements
+                    .iter()
+                    .find(|e| e.name == name || e.members.iter().any(|m| m == name))
             })
     }
 

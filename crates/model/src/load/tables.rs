@@ -106,7 +106,7 @@ fn entry(
             return Err(err("gives both `file` and values".into())
                 .hint("give either `file` or `x`, `y` (and `z`)"));
         }
-        from_file(name, file, source).map_err(|e| e.element(name))?
+        from_file(name, file, source, span)?
     } else {
         let axis = |k: &str| -> Result<Option<Vec<f64>>, ModelError> {
             t.get(k)
@@ -188,49 +188,66 @@ fn check_axis(_name: &str, key: &str, v: &[f64]) -> Result<(), String> {
     Ok(())
 }
 
-/// A table from a CSV, relative to the model: two columns `x, y` (1-D), or a grid whose
-/// header holds the y values after a first cell, and each row an x value then its z values.
+/// A table from a CSV, relative to the model: a header `x,y` (in either order: columns are
+/// read by name) then rows of numbers (1-D), or a grid whose header holds the y values after
+/// a first cell that is not a number (`x\y`), and each row an x value then its z values.
 type Grid = (Vec<f64>, Vec<f64>, Option<Vec<Vec<f64>>>);
 
-fn from_file(name: &str, file: &str, source: &Source) -> Result<Grid, ModelError> {
+fn from_file(
+    name: &str,
+    file: &str,
+    source: &Source,
+    span: &Range<usize>,
+) -> Result<Grid, ModelError> {
     let path = relative(&source.file, file);
     let shown = path.display().to_string();
-    let header: Vec<Option<f64>> = std::fs::read_to_string(&path)
-        .ok()
-        .and_then(|t| {
-            t.lines()
-                .find(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'))
-                .map(|l| {
-                    l.split(',')
-                        .skip(1)
-                        .map(|c| c.trim().parse().ok())
-                        .collect()
-                })
-        })
-        .unwrap_or_default();
-    let data = DataFile::read(&path, &shown)?;
-    if !header.is_empty() && header.iter().all(Option::is_some) && data.names.len() > 2 {
+    let what = format!("table `{}`", clip(name));
+    let data = DataFile::read(&path, &shown)
+        .map_err(|e| source.data_err(ErrorKind::Table, span, &what, &shown, e, "x,y"))?;
+    let refuse = |m: String, hint: &str| {
+        source
+            .err(
+                ErrorKind::Table,
+                Some(span),
+                format!("{what}: `{shown}` {m}"),
+            )
+            .hint(hint.to_owned())
+    };
+    const HINTS: &str = "a 1-D table file starts with the header `x,y`; a 2-D one with `x\\y, y1, y2, …` (numbers after the first cell)";
+    let number = |c: &String| c.parse::<f64>().is_ok();
+    let names = &data.names;
+    if names.iter().all(number) {
+        return Err(refuse(
+            format!(
+                "has no header: its first line `{}` is numbers",
+                clip(&names.join(","))
+            ),
+            HINTS,
+        ));
+    }
+    if names.len() > 2 && names[1..].iter().all(number) {
         // 2-D: the header's cells after the first are the y values
-        let y: Vec<f64> = header.into_iter().flatten().collect();
+        let y: Vec<f64> = names[1..].iter().filter_map(|c| c.parse().ok()).collect();
         let x = data.columns[0].clone();
         let z: Vec<Vec<f64>> = (0..x.len())
-            .map(|i| (1..data.names.len()).map(|k| data.columns[k][i]).collect())
+            .map(|i| (1..names.len()).map(|k| data.columns[k][i]).collect())
             .collect();
         return Ok((x, y, Some(z)));
     }
-    if data.names.len() != 2 {
-        return Err(ModelError::new(
-            ErrorKind::Table,
-            &shown,
+    let (Some(kx), Some(ky), 2) = (data.column("x"), data.column("y"), names.len()) else {
+        return Err(refuse(
             format!(
-                "table `{name}`: a 1-D table file has 2 columns (x, y), this one {}",
-                data.names.len()
+                "has the columns {}: a 1-D table file has the two columns `x` and `y`",
+                clip(
+                    &names
+                        .iter()
+                        .map(|n| format!("`{n}`"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
             ),
-        )
-        .at(Some((1, 1)))
-        .hint(
-            "for a 2-D table the header is `x\\y, y1, y2, …` with numbers after the first cell",
+            HINTS,
         ));
-    }
-    Ok((data.columns[0].clone(), data.columns[1].clone(), None))
+    };
+    Ok((data.columns[kx].clone(), data.columns[ky].clone(), None))
 }

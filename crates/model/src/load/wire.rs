@@ -116,9 +116,8 @@ fn bond(
         // A composite stands for the member port it exposes.
         let inner: String;
         if let Some(def) = src
-            .elements
-            .iter()
-            .find(|d| d.name == el && !d.ports.is_empty())
+            .entry_of(el)
+            .filter(|d| d.name == el && !d.ports.is_empty())
         {
             let exposed: Vec<&str> = def.ports.iter().map(|(n, _)| n.as_str()).collect();
             let pick = match port {
