@@ -19,6 +19,7 @@ pub mod plot;
 pub mod reduce;
 pub mod run;
 pub mod sweep;
+pub mod stress;
 
 /// Exit statuses (README, "Exit status").
 pub const BAD_INPUT: u8 = 2;

@@ -237,6 +237,10 @@ impl Element for ArmStress {
             if l.spaced.is_empty() {
                 continue;
             }
+            out.push(SignalSpec {
+                name: format!("grid{}.x", l.grid.link() + 1),
+                dim: l.spaced.len(),
+            });
             for q in self.quantities(l.grid.link()) {
                 out.push(SignalSpec {
                     name: format!("grid{}.{q}", l.grid.link() + 1),
@@ -322,6 +326,10 @@ impl Element for ArmStress {
             if l.spaced.is_empty() {
                 continue;
             }
+            for (c, &j) in l.spaced.iter().enumerate() {
+                io.set_y(y, c, l.grid.xs()[j]);
+            }
+            y += 1;
             for q in self.quantities(l.grid.link()) {
                 for (c, &j) in l.spaced.iter().enumerate() {
                     io.set_y(y, c, value(l, f, q, j));
