@@ -10,7 +10,8 @@
 #![allow(
     clippy::unwrap_used,
     clippy::expect_used,
-    clippy::many_single_char_names
+    clippy::many_single_char_names,
+    clippy::needless_range_loop
 )]
 
 use bg_manipulator::stress::SectionGrid;

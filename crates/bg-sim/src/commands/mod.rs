@@ -18,8 +18,8 @@ pub mod modes;
 pub mod plot;
 pub mod reduce;
 pub mod run;
-pub mod sweep;
 pub mod stress;
+pub mod sweep;
 
 /// Exit statuses (README, "Exit status").
 pub const BAD_INPUT: u8 = 2;

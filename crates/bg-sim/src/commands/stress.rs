@@ -76,11 +76,30 @@ struct LinkEnvelope {
     arm: String,
     link: usize,
     x: Vec<f64>,
-    /// Per quantity: (max, t of max, min, t of min) at each x.
-    env: Vec<(Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>)>,
+    /// Per quantity, its envelope.
+    env: Vec<Envelope>,
     has_sigma: bool,
     /// (x index, t, σ) of the largest |σ|, and the column of its history.
     hot: Option<(usize, f64, f64, String)>,
+}
+
+/// The max and min of a quantity at each x over the run, with their times.
+struct Envelope {
+    max: Vec<f64>,
+    t_max: Vec<f64>,
+    min: Vec<f64>,
+    t_min: Vec<f64>,
+}
+
+impl Envelope {
+    fn unknown(n: usize) -> Self {
+        Self {
+            max: vec![f64::NAN; n],
+            t_max: vec![f64::NAN; n],
+            min: vec![f64::NAN; n],
+            t_min: vec![f64::NAN; n],
+        }
+    }
 }
 
 /// A cylinder's peaks.
@@ -168,7 +187,11 @@ pub fn command(a: &Args) -> ExitCode {
     let mut links: Vec<(String, usize, bool)> = Vec::new();
     for arm in &arms {
         for k in 1..=64 {
-            let probe = |q: &str| model.equations.probe(&format!("{arm}_stress.grid{k}.{q}[0]"));
+            let probe = |q: &str| {
+                model
+                    .equations
+                    .probe(&format!("{arm}_stress.grid{k}.{q}[0]"))
+            };
             if probe("N").is_none() {
                 continue;
             }
@@ -180,7 +203,9 @@ pub fn command(a: &Args) -> ExitCode {
     }
     if links.is_empty() {
         return bad(match a.link {
-            Some(l) => format!("--link {l}: the arms have no such link with distributed mass or a section"),
+            Some(l) => {
+                format!("--link {l}: the arms have no such link with distributed mass or a section")
+            }
             None => "the arms have no link with distributed mass or a section".to_owned(),
         });
     }
@@ -198,7 +223,11 @@ pub fn command(a: &Args) -> ExitCode {
     };
     model.outputs.clear();
     for (arm, k, sigma) in &links {
-        let qs: &[&str] = if *sigma { &QUANTITIES } else { &QUANTITIES[..3] };
+        let qs: &[&str] = if *sigma {
+            &QUANTITIES
+        } else {
+            &QUANTITIES[..3]
+        };
         for q in std::iter::once(&"x").chain(qs) {
             for j in 0..a.points {
                 add(&mut model, format!("{arm}_stress.grid{k}.{q}[{j}]"));
@@ -226,7 +255,10 @@ pub fn command(a: &Args) -> ExitCode {
     };
     let mut code = ExitCode::SUCCESS;
     if let Some(e) = &outcome.error {
-        tell!("error: {}: the run stopped early: {e}; the envelopes cover the rows computed", model.file());
+        tell!(
+            "error: {}: the run stopped early: {e}; the envelopes cover the rows computed",
+            model.file()
+        );
         code = ExitCode::from(FAILED);
     }
     let tr = &outcome.trajectory;
@@ -244,7 +276,7 @@ pub fn command(a: &Args) -> ExitCode {
         let mut env = Vec::new();
         let mut hot: Option<(usize, f64, f64, String)> = None;
         for q in QUANTITIES {
-            let mut e = (vec![f64::NAN; a.points], vec![f64::NAN; a.points], vec![f64::NAN; a.points], vec![f64::NAN; a.points]);
+            let mut e = Envelope::unknown(a.points);
             if q.starts_with("sigma") && !sigma {
                 env.push(e);
                 continue;
@@ -261,10 +293,10 @@ pub fn command(a: &Args) -> ExitCode {
                         imin = r;
                     }
                 }
-                e.0[j] = v[imax];
-                e.1[j] = t[imax];
-                e.2[j] = v[imin];
-                e.3[j] = t[imin];
+                e.max[j] = v[imax];
+                e.t_max[j] = t[imax];
+                e.min[j] = v[imin];
+                e.t_min[j] = t[imin];
                 if q.starts_with("sigma") {
                     for r in [imax, imin] {
                         if hot.as_ref().is_none_or(|h| v[r].abs() > h.2.abs()) {
@@ -290,7 +322,10 @@ pub fn command(a: &Args) -> ExitCode {
             let (pp, pr, f) = (col(&cols[0]), col(&cols[1]), col(&cols[2]));
             CylinderPeaks {
                 name: name.clone(),
-                p_max: pp.iter().chain(&pr).fold(f64::NEG_INFINITY, |m, v| m.max(*v)),
+                p_max: pp
+                    .iter()
+                    .chain(&pr)
+                    .fold(f64::NEG_INFINITY, |m, v| m.max(*v)),
                 push: f.iter().fold(0.0, |m: f64, v| m.max(*v)),
                 pull: f.iter().fold(0.0, |m: f64, v| m.max(-*v)),
             }
@@ -305,7 +340,12 @@ pub fn command(a: &Args) -> ExitCode {
         StressFormat::Text => say!("{}", text_report(&envelopes, &peaks).trim_end()),
     }
     if let Some(dir) = &a.plot {
-        match figures(dir, &envelopes, tr, model.title.as_deref().unwrap_or(model.file())) {
+        match figures(
+            dir,
+            &envelopes,
+            tr,
+            model.title.as_deref().unwrap_or(model.file()),
+        ) {
             Ok(files) => {
                 for f in files {
                     tell!("wrote {}", f.display());
@@ -339,7 +379,7 @@ fn json_report(links: &[LinkEnvelope], cyl: &[CylinderPeaks]) -> Value {
             for (q, e) in QUANTITIES.iter().zip(&l.env) {
                 o.insert(
                     (*q).into(),
-                    json!({"max": arr(&e.0), "min": arr(&e.2), "t_max": arr(&e.1), "t_min": arr(&e.3)}),
+                    json!({"max": arr(&e.max), "min": arr(&e.min), "t_max": arr(&e.t_max), "t_min": arr(&e.t_min)}),
                 );
             }
             o.insert(
@@ -372,7 +412,11 @@ fn csv_report(links: &[LinkEnvelope]) -> String {
         for (j, x) in l.x.iter().enumerate() {
             let _ = write!(s, "{},{},{x}", l.arm, l.link);
             for e in &l.env {
-                let _ = write!(s, ",{},{},{},{}", e.0[j], e.1[j], e.2[j], e.3[j]);
+                let _ = write!(
+                    s,
+                    ",{},{},{},{}",
+                    e.max[j], e.t_max[j], e.min[j], e.t_min[j]
+                );
             }
             s.push('\n');
         }
@@ -383,21 +427,39 @@ fn csv_report(links: &[LinkEnvelope]) -> String {
 fn text_report(links: &[LinkEnvelope], cyl: &[CylinderPeaks]) -> String {
     let mut s = String::new();
     for l in links {
-        let _ = writeln!(s, "{} link {}: {} sections, x = 0 … {} m", l.arm, l.link, l.x.len(), l.x.last().copied().unwrap_or(0.0));
-        let units = [("N", 1e-3, "kN"), ("V", 1e-3, "kN"), ("M", 1e-3, "kN·m"), ("sigma_top", 1e-6, "MPa"), ("sigma_bottom", 1e-6, "MPa")];
+        let _ = writeln!(
+            s,
+            "{} link {}: {} sections, x = 0 … {} m",
+            l.arm,
+            l.link,
+            l.x.len(),
+            l.x.last().copied().unwrap_or(0.0)
+        );
+        let units = [
+            ("N", 1e-3, "kN"),
+            ("V", 1e-3, "kN"),
+            ("M", 1e-3, "kN·m"),
+            ("sigma_top", 1e-6, "MPa"),
+            ("sigma_bottom", 1e-6, "MPa"),
+        ];
         for ((q, scale, unit), e) in units.iter().zip(&l.env) {
             if q.starts_with("sigma") && !l.has_sigma {
                 continue;
             }
-            let (jmax, jmin) = (argmax(&e.0), argmin(&e.2));
+            let (jmax, jmin) = (argmax(&e.max), argmin(&e.min));
             let _ = writeln!(
                 s,
                 "  {q:<13} max {:>10.3} {unit} at x = {:.3} m, t = {:.3} s;  min {:>10.3} {unit} at x = {:.3} m, t = {:.3} s",
-                e.0[jmax] * scale, l.x[jmax], e.1[jmax], e.2[jmin] * scale, l.x[jmin], e.3[jmin]
+                e.max[jmax] * scale, l.x[jmax], e.t_max[jmax], e.min[jmin] * scale, l.x[jmin], e.t_min[jmin]
             );
         }
         if let Some((j, t, sg, _)) = &l.hot {
-            let _ = writeln!(s, "  hot spot: σ = {:.3} MPa at x = {:.3} m, t = {t:.3} s", sg * 1e-6, l.x[*j]);
+            let _ = writeln!(
+                s,
+                "  hot spot: σ = {:.3} MPa at x = {:.3} m, t = {t:.3} s",
+                sg * 1e-6,
+                l.x[*j]
+            );
         }
     }
     for c in cyl {
@@ -445,7 +507,7 @@ fn figures(
         for j in 0..l.x.len() {
             let _ = write!(csv, "{}", l.x[j]);
             for e in &l.env {
-                let _ = write!(csv, ",{},{}", e.0[j], e.2[j]);
+                let _ = write!(csv, ",{},{}", e.max[j], e.min[j]);
             }
             csv.push('\n');
         }
@@ -454,13 +516,31 @@ fn figures(
             y_label: y.to_owned(),
             unit: Some(unit.to_owned()),
             x_range: None,
-            series: cols.iter().map(|(c, lab, s, d)| series(c, lab, *s, *d)).collect(),
+            series: cols
+                .iter()
+                .map(|(c, lab, s, d)| series(c, lab, *s, *d))
+                .collect(),
             line: 0,
         };
         let mut panels = vec![
-            panel("bending moment", "kN·m", &[("M_max", "max over the run", 1e-3, false), ("M_min", "min over the run", 1e-3, true)]),
-            panel("shear force", "kN", &[("V_max", "max", 1e-3, false), ("V_min", "min", 1e-3, true)]),
-            panel("axial force", "kN", &[("N_max", "max", 1e-3, false), ("N_min", "min", 1e-3, true)]),
+            panel(
+                "bending moment",
+                "kN·m",
+                &[
+                    ("M_max", "max over the run", 1e-3, false),
+                    ("M_min", "min over the run", 1e-3, true),
+                ],
+            ),
+            panel(
+                "shear force",
+                "kN",
+                &[("V_max", "max", 1e-3, false), ("V_min", "min", 1e-3, true)],
+            ),
+            panel(
+                "axial force",
+                "kN",
+                &[("N_max", "max", 1e-3, false), ("N_min", "min", 1e-3, true)],
+            ),
         ];
         if l.has_sigma {
             panels.push(panel(
@@ -496,10 +576,23 @@ fn figures(
             let results = bg_sim::plot::Results::parse(&csv).map_err(|(_, m)| m)?;
             let plot = Plot {
                 file: format!("stress-hot-spot-{}-link{}", l.arm, l.link),
-                title: format!("{title}: link {} hot spot at x = {:.3} m ({})", l.link, l.x[*j], if column.contains("sigma_top") { "top fibre" } else { "bottom fibre" }),
+                title: format!(
+                    "{title}: link {} hot spot at x = {:.3} m ({})",
+                    l.link,
+                    l.x[*j],
+                    if column.contains("sigma_top") {
+                        "top fibre"
+                    } else {
+                        "bottom fibre"
+                    }
+                ),
                 x: "t".to_owned(),
                 x_label: "time [s]".to_owned(),
-                panels: vec![panel("normal stress", "MPa", &[("sigma", "σ at the hot spot", 1e-6, false)])],
+                panels: vec![panel(
+                    "normal stress",
+                    "MPa",
+                    &[("sigma", "σ at the hot spot", 1e-6, false)],
+                )],
                 line: 0,
             };
             written.extend(
