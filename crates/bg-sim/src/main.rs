@@ -12,6 +12,7 @@ mod commands;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use commands::fatigue;
 use commands::{
     bench, check, compare, energy, fmu, graph, kinds, linearize, modes, plot, reduce, run, stress,
     sweep, FAILED,
@@ -78,6 +79,9 @@ enum Command {
     /// outer-fibre σ (max and min at every section, with their times), the hot spot and its
     /// history, the cylinders' peak pressures and forces (docs/stress.md).
     Stress(stress::Args),
+    /// Rainflow-count a column of a results CSV (ASTM E1049-85) and its Palmgren–Miner
+    /// damage on an S–N curve (EN 1993-1-9, DNV-RP-C203 presets or explicit).
+    Fatigue(fatigue::Args),
 }
 
 fn main() -> ExitCode {
@@ -126,5 +130,6 @@ fn dispatch(command: Command) -> ExitCode {
         Command::Plot(a) => plot::command(&a),
         Command::Fmu(a) => fmu::command(&a),
         Command::Stress(a) => stress::command(&a),
+        Command::Fatigue(a) => fatigue::command(&a),
     }
 }

@@ -12,6 +12,7 @@
 mod bode;
 mod contour;
 mod energy;
+mod fatigue;
 mod figure;
 mod quick;
 mod results;
@@ -26,6 +27,7 @@ use plotters::style::register_font;
 pub use bode::bode;
 pub use contour::{contour, Map};
 pub use energy::{energy_bars, energy_segments, Segment};
+pub use fatigue::fatigue;
 pub use figure::{draw, draw_all};
 pub use quick::quick_look;
 pub use results::{not_a_regular_file, Results, PLOT_ROWS};

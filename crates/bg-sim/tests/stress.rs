@@ -83,6 +83,8 @@ fn stress_json_has_the_fixed_shape_and_consistent_envelopes() {
             assert!(c.get(key).is_some(), "{key}");
         }
         assert!(c["p_max"].as_f64().unwrap() > 1e6);
+        // the crane's cylinders have their default rod checks (docs/fatigue.md)
+        assert!(c["buckling_margin"].as_f64().unwrap() > 0.0);
     }
     for f in [
         "stress-envelope-crane-link1.png",

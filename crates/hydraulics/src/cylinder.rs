@@ -19,6 +19,12 @@
 //!
 //! Chamber pressures start from [`InitialPressures`]; [`hold_pressures`] is the scene's
 //! static initialisation rule.
+//!
+//! **Rod check.** A member `rod_check` ([`RodCheck`], [`crate::buckling`]) publishes the rod
+//! force (`force`: F_c − F_stop, push positive), its critical load (`p_cr`: Euler with the
+//! current pin-to-pin length l and the end fixity `buckling`, the Johnson parabola for a
+//! short rod when `yield` is given), `utilisation` = force/p_cr and `buckling_margin` =
+//! p_cr/force. It writes signals only, so a run evaluates it only when an output reads it.
 
 use bondgraph::kind::{
     member_name, BuildError, Change, KindDecl, ParamDecl, Params, Simplification,
@@ -27,6 +33,7 @@ use bondgraph::{BondGraph, Composite, Error, OneJunction, Param, ParamError, Zer
 
 use crate::{fluid, orifice};
 
+use crate::buckling::{self, Fixity, Rod, RodCheck};
 use crate::{Chamber, EndStop, FluidOptions, Leakage, Piston, Side, Valve};
 
 /// The chamber pressures (P_p, P_r) that hold force `force` (N, positive pushing the pins
@@ -122,6 +129,10 @@ pub struct Cylinder {
     pub end_stop: Option<EndStopSpec>,
     /// Entrained air and cavitation in both chambers (default: off, constant β).
     pub fluid: FluidOptions,
+    /// The rod as a column for the buckling check; `None` (from [`Cylinder::new`]): a steel
+    /// rod of the diameter the areas give, √(4(A_p − A_r)/π), pinned at both ends — if
+    /// A_p > A_r (a double-rod cylinder with equal areas then has no check).
+    pub rod: Option<Rod>,
 }
 
 /// Where the exposed ports of a cylinder added with [`Cylinder::add_to`] are: element names.
@@ -159,7 +170,28 @@ impl Cylinder {
             r_ext: None,
             end_stop: None,
             fluid: FluidOptions::default(),
+            rod: None,
         }
+    }
+
+    /// The rod diameter the areas give, √(4(A_p − A_r)/π) (m), if A_p > A_r.
+    #[must_use]
+    pub fn rod_diameter(&self) -> Option<f64> {
+        (self.a_p > self.a_r).then(|| (4.0 * (self.a_p - self.a_r) / std::f64::consts::PI).sqrt())
+    }
+
+    /// The rod as a column: the field [`Cylinder::rod`], or a steel rod pinned at both ends
+    /// with [`Cylinder::rod_diameter`]; `None` if neither is known (no rod check).
+    #[must_use]
+    pub fn rod(&self) -> Option<Rod> {
+        self.rod.or_else(|| {
+            Some(Rod {
+                d: self.rod_diameter()?,
+                e: buckling::STEEL_E,
+                yield_strength: None,
+                fixity: Fixity::PinnedPinned,
+            })
+        })
     }
 
     /// The initial pressures (P_p, P_r), Pa.
@@ -220,6 +252,9 @@ impl Cylinder {
         if let Some(r) = self.r_ext {
             ParamError::positive("r_ext", r)?;
         }
+        if let Some(rod) = self.rod() {
+            rod.validate()?;
+        }
         if let Some(e) = self.end_stop {
             ParamError::positive("k_stop", e.k)?;
             ParamError::non_negative("c_stop", e.c)?;
@@ -232,6 +267,7 @@ impl Cylinder {
     /// called `instance` (signals inside refer to `<instance>_piston.s`).
     pub fn composite(self, instance: &str) -> Result<Composite, ParamError> {
         self.validate()?;
+        let rod = self.rod();
         let stroke_signal = format!("{}.s", member_name(instance, "piston"));
         let stroke = || Param::modulated(vec![stroke_signal.clone()], |_, u| u[0]);
         let (p_p0, p_r0) = self.initial_pressures();
@@ -286,12 +322,22 @@ impl Cylinder {
                 .element("leak_r", Leakage::to_tank(r, self.p_t)?);
             c.bond("b_lp", "jp", "leak_p").bond("b_lr", "jr", "leak_r");
         }
+        let (length, b_rod, b_stop) = (
+            format!("{}.l", member_name(instance, "piston")),
+            format!("{}.e", member_name(instance, "b_rod")),
+            format!("{}.e", member_name(instance, "b_stop")),
+        );
+        let mut forces = vec![(b_rod.as_str(), 1.0)];
         if let Some(e) = self.end_stop {
             c.element(
                 "end_stop",
                 EndStop::new(stroke(), 0.0, self.s_max, e.k, e.c, e.width)?,
             );
             c.bond("b_stop", "rod", "end_stop");
+            forces.push((b_stop.as_str(), -1.0));
+        }
+        if let Some(rod) = rod {
+            c.element("rod_check", RodCheck::new(rod, &length, &forces)?);
         }
         c.port("mech", "rod").port("A", "jp").port("B", "jr");
         Ok(c)
@@ -400,6 +446,29 @@ pub const KIND: KindDecl = KindDecl::composite(
         fluid::P_VAPOUR,
         fluid::P_CAV_BAND,
         fluid::P_ATM,
+        ParamDecl::number(
+            "rod_d",
+            "m",
+            "rod diameter, for the buckling check (rod_check)",
+        )
+        .positive()
+        .optional("from the areas: √(4(a_p − a_r)/π)"),
+        ParamDecl::number("E", "Pa", "Young's modulus of the rod")
+            .positive()
+            .default(buckling::STEEL_E),
+        ParamDecl::number(
+            "yield",
+            "Pa",
+            "yield strength of the rod: the Johnson parabola for short rods",
+        )
+        .positive()
+        .optional("Euler only"),
+        ParamDecl::choice(
+            "buckling",
+            &Fixity::NAMES,
+            "pinned-pinned",
+            "end fixity of the rod as a column (K = 1, 2, 0.699, 0.5)",
+        ),
     ],
     build,
 )
@@ -447,6 +516,25 @@ fn build(p: &dyn Params) -> Result<Composite, BuildError> {
     c.r_int = p.optional("r_int")?;
     c.r_ext = p.optional("r_ext")?;
     c.fluid = fluid::options(p)?;
+    let fixity = buckling::fixity_of(&p.word("buckling")?)?;
+    c.rod = match p.optional("rod_d")?.or_else(|| c.rod_diameter()) {
+        Some(d) => Some(Rod {
+            d,
+            e: p.number("E")?,
+            yield_strength: p.optional("yield")?,
+            fixity,
+        }),
+        None => {
+            if let Some(k) = ["E", "yield", "buckling"].into_iter().find(|k| p.has(k)) {
+                return Err(BuildError::conflict(
+                    k,
+                    format!("`{k}` is a rod parameter, but a_p ≤ a_r gives no rod diameter"),
+                )
+                .hint("give the rod diameter `rod_d`"));
+            }
+            None
+        }
+    };
     c.initial = if p.has("p_p0") || p.has("p_r0") {
         if let Some(k) = ["hold_force", "p_pre"].into_iter().find(|k| p.has(k)) {
             return Err(BuildError::conflict(
@@ -570,5 +658,57 @@ mod tests {
         assert!(!names.contains(&"end_stop"));
         let ports: Vec<&str> = comp.ports.iter().map(|(n, _)| n.as_str()).collect();
         assert_eq!(ports, ["mech", "A", "B"]);
+    }
+
+    #[test]
+    fn the_rod_check_defaults_to_the_rod_the_areas_give() {
+        let (a_p, a_r) = (0.045_238_9, 0.042_411_5);
+        let c = Cylinder::new(a_p, a_r, 0.05, 2.75, 2.7, 1.5e9);
+        let rod = c.rod().unwrap();
+        assert!((rod.d - 0.06).abs() < 1e-6, "{}", rod.d);
+        assert_eq!(rod.fixity, Fixity::PinnedPinned);
+        assert!((rod.e - 210e9).abs() < 1.0);
+        let comp = c.composite("cyl1").unwrap();
+        let check = comp
+            .elements
+            .iter()
+            .find(|(n, _)| n == "rod_check")
+            .unwrap();
+        let inputs: Vec<String> = check
+            .1
+            .signal_inputs()
+            .into_iter()
+            .map(|s| s.name)
+            .collect();
+        assert_eq!(inputs, ["cyl1_piston.l", "cyl1_b_rod.e"]);
+        // with an end stop the rod force is F_c − F_stop
+        let mut c = Cylinder::new(a_p, a_r, 0.05, 2.75, 2.7, 1.5e9);
+        c.end_stop = Some(EndStopSpec {
+            k: 1e9,
+            c: 0.0,
+            width: 1e-5,
+        });
+        let comp = c.composite("c").unwrap();
+        let check = comp
+            .elements
+            .iter()
+            .find(|(n, _)| n == "rod_check")
+            .unwrap();
+        assert_eq!(check.1.signal_inputs().len(), 3);
+        // equal areas (a double-rod cylinder) give no diameter: no check unless rod_d is given
+        let c = Cylinder::new(0.01, 0.01, 0.05, 2.75, 2.7, 1.5e9);
+        assert!(c.rod().is_none());
+        let comp = c.composite("c").unwrap();
+        assert!(comp.elements.iter().all(|(n, _)| n != "rod_check"));
+        // a bad rod is refused with its key
+        let mut c = Cylinder::new(a_p, a_r, 0.05, 2.75, 2.7, 1.5e9);
+        c.rod = Some(Rod {
+            d: -0.06,
+            e: 210e9,
+            yield_strength: None,
+            fixity: Fixity::FixedFree,
+        });
+        let e = c.validate().unwrap_err();
+        assert!(e.to_string().contains("rod_d"), "{e}");
     }
 }

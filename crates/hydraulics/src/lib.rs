@@ -71,7 +71,8 @@
 //! ## The cylinder as one component
 //! [`Cylinder`] (`hydraulics.cylinder`) assembles chambers, piston, leakage, valve and end
 //! stop; [`Cylinder::composite`] for model files, [`Cylinder::add_to`] for a [`BondGraph`].
-//! [`hold_pressures`] is the static initialisation rule.
+//! [`hold_pressures`] is the static initialisation rule. [`buckling`]: the rod's Euler/Johnson
+//! load ([`buckling_load`], [`Fixity`]) and the check member [`RodCheck`].
 //!
 //! ## Model files
 //! [`KINDS`] lists every kind, each a [`bondgraph::KindDecl`] declared beside its law;
@@ -80,6 +81,7 @@
 //! [`BondGraph`]: bondgraph::BondGraph
 
 pub mod accumulator;
+pub mod buckling;
 pub mod chamber;
 pub mod check_valve;
 pub mod counterbalance_valve;
@@ -112,6 +114,7 @@ pub mod valve_2_2;
 pub mod valve_3_2;
 
 pub use accumulator::Accumulator;
+pub use buckling::{buckling_load, Fixity, Rod, RodCheck};
 pub use chamber::{Chamber, Side};
 pub use check_valve::CheckValve;
 pub use counterbalance_valve::CounterbalanceValve;

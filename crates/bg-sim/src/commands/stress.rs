@@ -5,7 +5,8 @@
 //!
 //! The section forces are the arm's ([`bg_manipulator::stress`]): evaluated at the output rows
 //! only, from the state and its derivative there. The rod buckling margin of each cylinder
-//! is `null` until the cylinders carry their rod data (`rod_d`, `E`, `buckling`).
+//! is the smallest over the run of its rod check's `buckling_margin`
+//! (`bg_hydraulics::buckling`), `null` for a cylinder without one.
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -108,6 +109,9 @@ struct CylinderPeaks {
     p_max: f64,
     push: f64,
     pull: f64,
+    /// The smallest buckling margin of the run (`<cyl>_rod_check.buckling_margin`), if the
+    /// cylinder has a rod check.
+    margin: Option<f64>,
 }
 
 fn elements_of_kind(text: &str, kind: &str) -> Vec<String> {
@@ -245,7 +249,9 @@ pub fn command(a: &Args) -> ExitCode {
             for n in &cols {
                 add(&mut model, n.clone());
             }
-            cyl_cols.push((c.clone(), cols));
+            let margin = format!("{c}_rod_check.buckling_margin");
+            let margin = add(&mut model, margin.clone()).then_some(margin);
+            cyl_cols.push((c.clone(), cols, margin));
         }
     }
     model.settings.interrupt = Some(interrupt_on_signals());
@@ -318,7 +324,7 @@ pub fn command(a: &Args) -> ExitCode {
     }
     let peaks: Vec<CylinderPeaks> = cyl_cols
         .iter()
-        .map(|(name, cols)| {
+        .map(|(name, cols, margin)| {
             let (pp, pr, f) = (col(&cols[0]), col(&cols[1]), col(&cols[2]));
             CylinderPeaks {
                 name: name.clone(),
@@ -328,11 +334,14 @@ pub fn command(a: &Args) -> ExitCode {
                     .fold(f64::NEG_INFINITY, |m, v| m.max(*v)),
                 push: f.iter().fold(0.0, |m: f64, v| m.max(*v)),
                 pull: f.iter().fold(0.0, |m: f64, v| m.max(-*v)),
+                margin: margin
+                    .as_ref()
+                    .map(|m| col(m).iter().fold(f64::INFINITY, |a, v| a.min(*v))),
             }
         })
         .collect();
-    if !peaks.is_empty() {
-        tell!("warning: buckling_margin is null: the cylinders declare no rod data (rod_d, E, buckling) yet");
+    for c in peaks.iter().filter(|c| c.margin.is_none()) {
+        tell!("warning: {}: buckling_margin is null: the cylinder has no rod check (rod_d, E, buckling; docs/fatigue.md)", c.name);
     }
     match a.format {
         StressFormat::Json => say!("{:#}", json_report(&envelopes, &peaks)),
@@ -396,7 +405,7 @@ fn json_report(links: &[LinkEnvelope], cyl: &[CylinderPeaks]) -> Value {
         .iter()
         .map(|c| {
             json!({"name": c.name, "p_max": num(c.p_max), "force_push_max": num(c.push),
-                   "force_pull_max": num(c.pull), "buckling_margin": null})
+                   "force_pull_max": num(c.pull), "buckling_margin": c.margin.map_or(Value::Null, num)})
         })
         .collect();
     json!({"links": links, "cylinders": cylinders})
@@ -465,8 +474,15 @@ fn text_report(links: &[LinkEnvelope], cyl: &[CylinderPeaks]) -> String {
     for c in cyl {
         let _ = writeln!(
             s,
-            "cylinder {}: p_max {:.3} MPa, push {:.1} kN, pull {:.1} kN, buckling margin: not declared",
-            c.name, c.p_max * 1e-6, c.push * 1e-3, c.pull * 1e-3
+            "cylinder {}: p_max {:.3} MPa, push {:.1} kN, pull {:.1} kN, buckling margin {}",
+            c.name,
+            c.p_max * 1e-6,
+            c.push * 1e-3,
+            c.pull * 1e-3,
+            c.margin.map_or_else(
+                || "not declared".to_owned(),
+                |m| format!("{m:.3} (smallest of the run)")
+            )
         );
     }
     s
