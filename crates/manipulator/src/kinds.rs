@@ -410,7 +410,7 @@ fn section(
         Ok(Some(v))
     };
     let area = get("A")?
-        .ok_or_else(|| BuildError::missing("A", "a section needs its area `A`").within(at))?;
+        .ok_or_else(|| BuildError::missing("A", format!("`{at}` needs its area `A`")).within(at))?;
     let built =
         match (
             get("I")?,
@@ -427,7 +427,9 @@ fn section(
             }
             _ => return Err(BuildError::invalid(
                 "section",
-                "a section needs `A` with either `I`, `c_top`, `c_bottom` or `W_top`, `W_bottom`",
+                format!(
+                    "`{at}` needs `A` with either `I`, `c_top`, `c_bottom` or `W_top`, `W_bottom`"
+                ),
             )
             .within(at)
             .hint("section = { A = \"A\", I = \"I\", c_top = 0.19, c_bottom = 0.19 }")),
