@@ -411,29 +411,30 @@ fn section(
     };
     let area = get("A")?
         .ok_or_else(|| BuildError::missing("A", format!("`{at}` needs its area `A`")).within(at))?;
-    let built =
-        match (
-            get("I")?,
-            get("c_top")?,
-            get("c_bottom")?,
-            get("W_top")?,
-            get("W_bottom")?,
-        ) {
-            (Some(i), Some(ct), Some(cb), None, None) => {
-                crate::stress::CrossSection::from_distances(length, area, &i, &ct, &cb)
-            }
-            (None, None, None, Some(wt), Some(wb)) => {
-                crate::stress::CrossSection::from_moduli(length, area, wt, wb)
-            }
-            _ => return Err(BuildError::invalid(
+    let built = match (
+        get("I")?,
+        get("c_top")?,
+        get("c_bottom")?,
+        get("W_top")?,
+        get("W_bottom")?,
+    ) {
+        (Some(i), Some(ct), Some(cb), None, None) => {
+            crate::stress::CrossSection::from_distances(length, area, &i, &ct, &cb)
+        }
+        (None, None, None, Some(wt), Some(wb)) => {
+            crate::stress::CrossSection::from_moduli(length, area, wt, wb)
+        }
+        _ => {
+            return Err(BuildError::invalid(
                 "section",
                 format!(
                     "`{at}` needs `A` with either `I`, `c_top`, `c_bottom` or `W_top`, `W_bottom`"
                 ),
             )
             .within(at)
-            .hint("section = { A = \"A\", I = \"I\", c_top = 0.19, c_bottom = 0.19 }")),
-        };
+            .hint("section = { A = \"A\", I = \"I\", c_top = 0.19, c_bottom = 0.19 }"))
+        }
+    };
     built.map(Some).map_err(|e| BuildError::from(e).within(at))
 }
 
