@@ -14,8 +14,8 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use commands::fatigue;
 use commands::{
-    bench, check, compare, energy, fmu, graph, kinds, linearize, modes, plot, reduce, run, sweep,
-    FAILED,
+    bench, check, compare, energy, fmu, graph, kinds, linearize, modes, plot, reduce, run, stress,
+    sweep, FAILED,
 };
 
 #[derive(Parser)]
@@ -75,6 +75,10 @@ enum Command {
     /// Export the model as an FMI 2.0 (or --fmi 3) co-simulation FMU: the model and its data
     /// in resources/, the engine library (`cargo build -p bg-fmu`) in binaries/ (docs/fmu.md).
     Fmu(fmu::Args),
+    /// Stresses along the arm's flexible links over a run: envelopes of N, V, M and the
+    /// outer-fibre σ (max and min at every section, with their times), the hot spot and its
+    /// history, the cylinders' peak pressures and forces (docs/stress.md).
+    Stress(stress::Args),
     /// Rainflow-count a column of a results CSV (ASTM E1049-85) and its Palmgren–Miner
     /// damage on an S–N curve (EN 1993-1-9, DNV-RP-C203 presets or explicit).
     Fatigue(fatigue::Args),
@@ -91,6 +95,7 @@ fn main() -> ExitCode {
             | Command::Modes { .. }
             | Command::Linearize { .. }
             | Command::Energy { .. }
+            | Command::Stress { .. }
     );
     let code = dispatch(cli.command);
     let lost = report::STDOUT_ERROR.lock().ok().and_then(|e| *e);
@@ -124,6 +129,7 @@ fn dispatch(command: Command) -> ExitCode {
         Command::Compare(a) => compare::command(&a),
         Command::Plot(a) => plot::command(&a),
         Command::Fmu(a) => fmu::command(&a),
+        Command::Stress(a) => stress::command(&a),
         Command::Fatigue(a) => fatigue::command(&a),
     }
 }

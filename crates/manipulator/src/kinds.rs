@@ -130,6 +130,50 @@ const LINK: &[ParamDecl] = &[
     )
     .of("x")
     .optional("uniform"),
+    ParamDecl::table(
+        "section",
+        SECTION,
+        "cross-section for stresses: A with I, c_top, c_bottom or W_top, W_bottom (docs/stress.md)",
+    )
+    .optional("none"),
+];
+
+/// A link's cross-section for stress recovery (docs/stress.md): each entry a number or an
+/// expression of x like the `*_of_x` profiles.
+const SECTION: &[ParamDecl] = &[
+    ParamDecl::modulated("A", "m²", "area (for N/A)").of("x"),
+    ParamDecl::modulated("I", "m⁴", "second moment of area (with c_top, c_bottom)")
+        .of("x")
+        .optional("give W_top and W_bottom"),
+    ParamDecl::modulated(
+        "c_top",
+        "m",
+        "distance of the +y fibre from the neutral axis",
+    )
+    .of("x")
+    .optional("give W_top"),
+    ParamDecl::modulated(
+        "c_bottom",
+        "m",
+        "distance of the −y fibre from the neutral axis",
+    )
+    .of("x")
+    .optional("give W_bottom"),
+    ParamDecl::modulated("W_top", "m³", "section modulus of the +y fibre, I/c_top")
+        .of("x")
+        .optional("give I and c_top"),
+    ParamDecl::modulated(
+        "W_bottom",
+        "m³",
+        "section modulus of the −y fibre, I/c_bottom",
+    )
+    .of("x")
+    .optional("give I and c_bottom"),
+];
+
+const STRESS_AT: &[ParamDecl] = &[
+    ParamDecl::count("link", "the link, 1, 2, …").range(Range::at_least(1.0)),
+    ParamDecl::number("x", "m", "distance from its joint along the chord"),
 ];
 
 /// Samples of a profile given as an expression of x (equally spaced from 0 to L).
@@ -176,6 +220,10 @@ pub const PLANAR_ARM: KindDecl = KindDecl::composite(
         ParamDecl::number("lumped_damping", "N·s/m", "spring damping of lumped masses (with \"springs\")").non_negative().default(0.0),
         ParamDecl::flag("paper_reactions", false, "also publish rho{k}_paper (springs only)"),
         ParamDecl::flag("geometric_stiffening", false, "keep the axial shortening of bent links (axial-force stiffening; docs/manipulator.md)"),
+        ParamDecl::tables("stress_at", STRESS_AT, "sections whose N, V, M, M_modal, sigma_top, sigma_bottom are published (docs/stress.md)").optional("none"),
+        ParamDecl::count("stress_grid", "equally spaced sections per link published as grid{k}.* (bg-sim stress sets it)")
+            .range(Range::closed(0.0, 4096.0))
+            .default(0.0),
     ],
     build_planar_arm,
 )
@@ -345,6 +393,51 @@ fn profile_of_x(p: &Param, key: &str, at: &str, length: f64) -> Result<Vec<f64>,
     }
 }
 
+/// The `section = { … }` of a link table, if any.
+fn section(
+    t: &dyn Params,
+    length: f64,
+    at: &str,
+) -> Result<Option<crate::stress::CrossSection>, BuildError> {
+    let Some(s) = t.table("section")? else {
+        return Ok(None);
+    };
+    let get = |key: &str| -> Result<Option<Vec<f64>>, BuildError> {
+        if !s.has(key) {
+            return Ok(None);
+        }
+        let v = profile_of_x(&s.modulated(key)?, key, at, length).map_err(|e| e.within(at))?;
+        Ok(Some(v))
+    };
+    let area = get("A")?
+        .ok_or_else(|| BuildError::missing("A", format!("`{at}` needs its area `A`")).within(at))?;
+    let built = match (
+        get("I")?,
+        get("c_top")?,
+        get("c_bottom")?,
+        get("W_top")?,
+        get("W_bottom")?,
+    ) {
+        (Some(i), Some(ct), Some(cb), None, None) => {
+            crate::stress::CrossSection::from_distances(length, area, &i, &ct, &cb)
+        }
+        (None, None, None, Some(wt), Some(wb)) => {
+            crate::stress::CrossSection::from_moduli(length, area, wt, wb)
+        }
+        _ => {
+            return Err(BuildError::invalid(
+                "section",
+                format!(
+                    "`{at}` needs `A` with either `I`, `c_top`, `c_bottom` or `W_top`, `W_bottom`"
+                ),
+            )
+            .within(at)
+            .hint("section = { A = \"A\", I = \"I\", c_top = 0.19, c_bottom = 0.19 }"))
+        }
+    };
+    built.map(Some).map_err(|e| BuildError::from(e).within(at))
+}
+
 fn pin(t: &dyn Params, at: &str) -> Result<Pin, BuildError> {
     if t.has("ground") {
         if let Some(k) = ["link", "x"].into_iter().find(|k| t.has(k)) {
@@ -388,7 +481,19 @@ fn scene(p: &dyn Params) -> Result<ArmScene, BuildError> {
             "needs `links = [ … ]` with at least one link",
         ));
     }
+    let sections = p
+        .tables("links")?
+        .iter()
+        .zip(&links)
+        .enumerate()
+        .map(|(k, (t, l))| section(t.as_ref(), l.length(), &format!("links[{}].section", k + 1)))
+        .collect::<Result<Vec<_>, _>>()?;
     let mut scene = ArmScene::new(links, p.number("gravity")?);
+    scene.sections = sections;
+    for t in p.tables("stress_at")? {
+        scene.stress_at.push((t.count("link")? - 1, t.number("x")?));
+    }
+    scene.stress_grid = p.count("stress_grid")?;
     scene.quadrature_points = p.count("quadrature_points")?;
     scene.q0 = p.vector("q0")?;
     scene.u0 = p.vector("u0")?;

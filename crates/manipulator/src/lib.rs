@@ -85,6 +85,9 @@ pub mod reactions;
 // The per-station reference of the tests
 pub mod reference;
 
+// Stress recovery: section forces, modal moment, cross-sections (docs/stress.md)
+pub mod stress;
+
 // Bond-graph elements (section 4), the scene, the kinds
 pub mod elements;
 pub mod kinds;

@@ -82,6 +82,12 @@ pub struct ArmScene {
     /// With lumped masses on springs, also publish the reaction forces of the paper's
     /// variant (masses moving rigidly with their pins) as `rho{k}_paper`.
     pub paper_reactions: bool,
+    /// Cross-sections for stress recovery, one per link (`None`: none declared).
+    pub sections: Vec<Option<crate::stress::CrossSection>>,
+    /// Sections (link 0-based, x) whose N, V, M, σ are published by the stress block.
+    pub stress_at: Vec<(usize, f64)>,
+    /// Equally spaced sections per link published as vectors `grid{k}.*` (0: none).
+    pub stress_grid: usize,
 }
 
 /// Pad `v` with zeros to length `n`, or complain that it is longer.
@@ -113,6 +119,9 @@ impl ArmScene {
             lumped_masses: Vec::new(),
             lumped_model: LumpedMassModel::Omitted,
             paper_reactions: false,
+            sections: Vec::new(),
+            stress_at: Vec::new(),
+            stress_grid: 0,
         }
     }
 
@@ -223,6 +232,23 @@ impl ArmScene {
             forces,
             pin_forces,
         };
+        if !self.stress_at.is_empty() || self.stress_grid > 0 {
+            // only when asked for: the block is read by outputs alone (docs/stress.md)
+            let joints = padded("damping", &self.damping, n)?[..arm.n_links()].to_vec();
+            c.element(
+                "stress",
+                crate::stress::ArmStress::new(
+                    arm.clone(),
+                    &self.actuators,
+                    &springs,
+                    joints,
+                    &self.sections,
+                    &self.stress_at,
+                    self.stress_grid,
+                    inputs.clone(),
+                )?,
+            );
+        }
         c.element(
             "rho",
             ArmReactions::new(arm, &self.actuators, &springs, inputs)?

@@ -62,6 +62,20 @@ pub(super) fn read(
     (outputs, notes, refused)
 }
 
+/// A stress output written `<arm>.link<k>.<quantity>(x=<number>)` (docs/stress.md) as the
+/// signal of the arm's stress block: `<arm>_stress.link<k>.<quantity>(x=<x as f64 prints>)`;
+/// `None` if `name` is not of that form.
+fn stress_alias(name: &str) -> Option<String> {
+    let (head, x) = name.strip_suffix(')')?.split_once("(x=")?;
+    let x: f64 = x.trim().parse().ok()?;
+    let mut parts = head.splitn(3, '.');
+    let (arm, link, quantity) = (parts.next()?, parts.next()?, parts.next()?);
+    let k: usize = link.strip_prefix("link")?.parse().ok()?;
+    let known = ["N", "V", "M", "M_modal", "sigma_top", "sigma_bottom"];
+    (known.contains(&quantity) && !arm.is_empty())
+        .then(|| format!("{arm}_stress.link{k}.{quantity}(x={x})"))
+}
+
 /// Column `col` reading `name`, and a note if it likely meant another variable:
 /// `p_hose = "hose.P"` reads the power, next to `hose.p`, the pressure (a column whose name
 /// starts with `P` or says `power` is taken to mean a power).
@@ -81,7 +95,21 @@ fn column(
             )
             .hint(format!("column names are 1 to {MAX_COLUMN_NAME} letters, digits, `_`, `.`, `[`, `]`, starting with a letter or `_`; `t` is the first column already, `time` and `pi` are reserved")));
     }
-    let probe = eqs.probe(name.get_ref()).ok_or_else(|| {
+    let probe = eqs
+        .probe(name.get_ref())
+        .or_else(|| stress_alias(name.get_ref()).and_then(|n| eqs.probe(&n)));
+    if probe.is_none() {
+        if let Some(canonical) = stress_alias(name.get_ref()) {
+            return Err(source
+                .err(
+                    ErrorKind::Settings,
+                    Some(&name.span()),
+                    format!("[outputs] `{}`: no stress section `{canonical}`", col.get_ref()),
+                )
+                .hint("declare the section on the arm: `stress_at = [{ link = 1, x = 4.0 }]`; sigma_top and sigma_bottom also need `section = { … }` on the link (docs/stress.md)"));
+        }
+    }
+    let probe = probe.ok_or_else(|| {
         let el = name.get_ref().split('.').next().unwrap_or("");
         let offers: Vec<&String> = names
             .iter()
