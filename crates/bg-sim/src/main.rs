@@ -13,8 +13,8 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use commands::{
-    bench, check, compare, energy, fmu, graph, kinds, linearize, modes, plot, reduce, run, sweep,
-    FAILED,
+    bench, check, compare, energy, fmu, graph, kinds, linearize, modes, plot, reduce, run, sea,
+    sweep, FAILED,
 };
 
 #[derive(Parser)]
@@ -74,6 +74,10 @@ enum Command {
     /// Export the model as an FMI 2.0 (or --fmi 3) co-simulation FMU: the model and its data
     /// in resources/, the engine library (`cargo build -p bg-fmu`) in binaries/ (docs/fmu.md).
     Fmu(fmu::Args),
+    /// An irregular sea state (JONSWAP or Pierson–Moskowitz) as a CSV time series: the wave
+    /// elevation and, with --rao, the vessel's heave, sway and roll at a point; --plot draws
+    /// the record and its spectrum against the target (docs/sea-states.md).
+    Sea(sea::Args),
 }
 
 fn main() -> ExitCode {
@@ -120,5 +124,6 @@ fn dispatch(command: Command) -> ExitCode {
         Command::Compare(a) => compare::command(&a),
         Command::Plot(a) => plot::command(&a),
         Command::Fmu(a) => fmu::command(&a),
+        Command::Sea(a) => sea::command(&a),
     }
 }

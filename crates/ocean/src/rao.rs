@@ -319,4 +319,27 @@ heading_deg,omega_rad_s,heave_amp_m_per_m,heave_phase_deg,sway_amp_m_per_m,sway_
         assert!(e.message.contains("negative"));
         assert!(Rao::parse("# nothing\n").is_err());
     }
+
+    /// The sample table in `data/` reads, and is shaped as its header says: heave → 1 at
+    /// low frequency, its resonance in 0.6–0.8 rad/s, → 0 at high frequency; roll peaking
+    /// in beam seas near the 8–10 s roll period, nothing in head seas.
+    #[test]
+    fn the_sample_supply_vessel_table_reads_and_has_the_documented_shape() {
+        let r = Rao::parse(include_str!("../../../data/rao_supply_vessel.csv")).unwrap();
+        assert_eq!(r.headings().len(), 8);
+        assert!((r.at(Dof::Heave, 0.1, 90.0).0 - 1.0).abs() < 0.02);
+        assert!(r.at(Dof::Heave, 2.0, 90.0).0 < 0.05);
+        let peak = |dof, heading| {
+            r.omegas()
+                .iter()
+                .copied()
+                .max_by(|a, b| r.at(dof, *a, heading).0.total_cmp(&r.at(dof, *b, heading).0))
+                .unwrap()
+        };
+        assert!((0.6..=0.8).contains(&peak(Dof::Heave, 90.0)));
+        let roll = peak(Dof::Roll, 90.0);
+        let period = 2.0 * std::f64::consts::PI / roll;
+        assert!((8.0..=10.0).contains(&period), "roll peak at {period} s");
+        assert!(r.at(Dof::Roll, roll, 180.0).0 < 1e-9);
+    }
 }
