@@ -237,4 +237,76 @@ t_end = 1.0
             assert!(e.contains("sea.toml:2"), "{sea}: {e}");
         }
     }
+
+    /// Run `text` (a position source `tip` feeding a spring `spring` of compliance 1) with
+    /// tight tolerances; the spring's final displacement.
+    fn spring_after(text: &str, file: &str) -> f64 {
+        let mut model = Model::from_text(file, text, &crate::Registry::with_core(), &[]).unwrap();
+        let x0 = model.equations.initial_state();
+        let settings = bondgraph::Settings {
+            t_end: 4.0,
+            rtol: 1e-10,
+            atol: 1e-12,
+            ..bondgraph::Settings::default()
+        };
+        let run = bondgraph::simulate(&mut model.equations, &x0, &settings, &[], vec![]);
+        assert!(run.error.is_none(), "{:?}", run.error);
+        run.x_final[0]
+    }
+
+    /// A position source whose position reads a sea input: the spring integrates the
+    /// source's flow back to x(4) − x(0), so the flow is the exact derivative.
+    #[test]
+    fn a_position_source_reading_a_sea_input_delivers_its_exact_rate() {
+        let text = r#"
+[inputs]
+eta = { sea = { hs = 2.5, tp = 9, seed = 3, duration = 600 } }
+[elements]
+tip = { kind = "Sf_position", x = "2*eta + 0.1*t^2" }
+spring = { kind = "C", c = 1.0 }
+[bonds]
+b = "tip -> spring"
+"#;
+        let q = spring_after(text, "pos.toml");
+        let rec = bg_ocean::WaveRecord::irregular(
+            bg_ocean::Spectrum::jonswap(2.5, 9.0, 3.3).unwrap(),
+            600.0,
+            0.1,
+            3,
+        )
+        .unwrap();
+        let want = 2.0 * (rec.eval(4.0).0 - rec.eval(0.0).0) + 0.1 * 16.0;
+        assert!((q - want).abs() < 1e-7, "{q} vs {want}");
+    }
+
+    /// Data with interp = "spline" through samples of a cubic: the position source follows
+    /// the cubic exactly, and a state signal in a motion is refused with a hint.
+    #[test]
+    fn a_position_source_reading_spline_data_follows_the_cubic_and_signals_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut csv = String::from("t,y\n");
+        for k in 0..=10 {
+            let t = 0.5 * f64::from(k);
+            csv.push_str(&format!("{t},{}\n", 1.0 + t - 0.2 * t * t + 0.03 * t * t * t));
+        }
+        std::fs::write(dir.path().join("y.csv"), csv).unwrap();
+        let file = dir.path().join("m.toml");
+        let text = r#"
+[inputs]
+y = { file = "y.csv", column = "y", interp = "spline" }
+[elements]
+tip = { kind = "Sf_position", x = "y" }
+spring = { kind = "C", c = 1.0 }
+[bonds]
+b = "tip -> spring"
+"#;
+        let q = spring_after(text, &file.display().to_string());
+        let f = |t: f64| 1.0 + t - 0.2 * t * t + 0.03 * t * t * t;
+        assert!((q - (f(4.0) - f(0.0))).abs() < 1e-8, "{q}");
+        let bad = text.replace("x = \"y\"", "x = \"spring.q\"");
+        let e = Model::from_text(&file.display().to_string(), &bad, &crate::Registry::with_core(), &[])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("spring.q") && e.contains("spline"), "{e}");
+    }
 }
