@@ -1,4 +1,4 @@
-//! PCG-XSH-RR 64/32 (O'Neill 2014, the generator `pcg32` of the PCG family): a 64-bit linear
+//! PCG-XSH-RR 64/32 (`pcg32` of the PCG family of generators): a 64-bit linear
 //! congruential state, multiplier 6364136223846793005, output by an xorshift and a random
 //! rotation to 32 bits. Integer arithmetic only (wrapping), so the same seed gives the same
 //! numbers on every machine and compiler. Seeding follows the reference `pcg32_srandom_r`
