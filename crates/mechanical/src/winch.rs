@@ -19,7 +19,9 @@
 //! the wire's spring, or the arm's wire payload.
 //! Outputs: `length` (L), `omega` (ω), `speed` (v).
 
-use bondgraph::element::{CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Slot, Stage, StateSpec};
+use bondgraph::element::{
+    CausalRule, Element, Io, Param, PortSpec, Ports, SignalSpec, Slot, Stage, StateSpec,
+};
 use bondgraph::energy::EnergyRole;
 use bondgraph::kind::{KindDecl, ParamDecl};
 use bondgraph::{LocalJacobian, ParamError, PortCausality};
@@ -203,7 +205,8 @@ mod tests {
         g.add("winch", winch).unwrap();
         g.add("rope_end", ZeroJunction).unwrap();
         g.add("stretch", OneJunction).unwrap();
-        g.add("spring", Capacitor::new(1.0 / k, m * G / k).unwrap()).unwrap();
+        g.add("spring", Capacitor::new(1.0 / k, m * G / k).unwrap())
+            .unwrap();
         g.add("damper", Resistor::new(c).unwrap()).unwrap();
         g.add("load", OneJunction).unwrap();
         g.add("mass", Inertia::new(m, 0.0).unwrap()).unwrap();
@@ -260,7 +263,10 @@ mod tests {
         let (length, _) = hang(winch, torque, m, t);
         let alpha = (torque + r * m * G) / (j + m * r * r);
         let want = 10.0 + 0.5 * r * alpha * t * t;
-        assert!((length - want).abs() < 1e-4 * (want - 10.0), "L = {length}, closed form {want}");
+        assert!(
+            (length - want).abs() < 1e-4 * (want - 10.0),
+            "L = {length}, closed form {want}"
+        );
     }
 
     #[test]
@@ -279,7 +285,10 @@ mod tests {
         let w = Winch::new(0.4, 20.0, 3.0, 15.0, brake, 0.05, 2.0).unwrap();
         // T, F, ω_m, v, u, p, L
         let point = [300.0, 2000.0, 0.0, 0.0, 0.8, 1.5, 2.0];
-        let ports = [(1, 1.0, PortCausality::FlowOut), (1, 1.0, PortCausality::FlowOut)];
+        let ports = [
+            (1, 1.0, PortCausality::FlowOut),
+            (1, 1.0, PortCausality::FlowOut),
+        ];
         assert_eq!(check_partials(&w, &ports, &point), Ok(2));
         assert!(Winch::new(0.0, 1.0, 1.0, 0.0, 0.0, 0.01, 0.0).is_err());
         assert!(Winch::new(0.5, 1.0, 1.0, -1.0, 0.0, 0.01, 0.0).is_err());

@@ -140,7 +140,9 @@ mod tests {
     fn a_sine_has_its_variance_under_the_welch_spectrum_and_its_period_at_the_peak() {
         let dt = 0.1;
         let (a, w0) = (1.5, 2.0 * PI / 8.0);
-        let x: Vec<f64> = (0..18_000).map(|k| a * (w0 * k as f64 * dt).cos()).collect();
+        let x: Vec<f64> = (0..18_000)
+            .map(|k| a * (w0 * k as f64 * dt).cos())
+            .collect();
         assert!((std(&x) - a / 2f64.sqrt()).abs() < 1e-3);
         let (w, s) = welch(&x, dt);
         let area: f64 = s.iter().sum::<f64>() * (w[1] - w[0]);

@@ -69,8 +69,16 @@ mod tests {
     #[test]
     fn derivatives_match_central_differences() {
         let h = Harmonics::new(vec![
-            Component { amplitude: 1.2, omega: 0.6, phase: 0.3 },
-            Component { amplitude: 0.4, omega: 1.7, phase: -2.0 },
+            Component {
+                amplitude: 1.2,
+                omega: 0.6,
+                phase: 0.3,
+            },
+            Component {
+                amplitude: 0.4,
+                omega: 1.7,
+                phase: -2.0,
+            },
         ]);
         for t in [0.0, 3.3, 117.0] {
             let (x, v, a) = h.eval(t);

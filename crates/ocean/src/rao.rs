@@ -91,8 +91,9 @@ pub struct Rao {
 }
 
 fn wrap_deg(d: f64) -> f64 {
+    // into (−180, 180]: rem_euclid gives [−180, 180), and −180 turns to 180
     let w = (d + 180.0).rem_euclid(360.0) - 180.0;
-    if w == -180.0 {
+    if w <= -180.0 {
         180.0
     } else {
         w
@@ -106,8 +107,9 @@ impl Rao {
     /// The file cannot be read, or [`Rao::parse`] refuses it.
     pub fn read(path: &Path) -> Result<Self, OceanError> {
         let text = std::fs::read_to_string(path).map_err(|e| {
-            OceanError::new(format!("cannot read {}: {e}", path.display()))
-                .hint("give the RAO file's path relative to the model file or the working directory")
+            OceanError::new(format!("cannot read {}: {e}", path.display())).hint(
+                "give the RAO file's path relative to the model file or the working directory",
+            )
         })?;
         Self::parse(&text)
     }
@@ -125,7 +127,10 @@ impl Rao {
             .map(|(k, l)| (k + 1, l.trim()))
             .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
         let (hline, header) = lines.next().ok_or_else(|| {
-            OceanError::new("the RAO file has no header").hint(format!("the header names the columns {}", COLUMNS.join(",")))
+            OceanError::new("the RAO file has no header").hint(format!(
+                "the header names the columns {}",
+                COLUMNS.join(",")
+            ))
         })?;
         let names: Vec<&str> = header.split(',').map(str::trim).collect();
         let mut index = [0usize; 8];
@@ -154,30 +159,55 @@ impl Rao {
             let mut v = [0.0; 8];
             for c in 0..8 {
                 let s = cells[index[c]];
-                v[c] = s.parse::<f64>().ok().filter(|x| x.is_finite()).ok_or_else(|| {
-                    OceanError::at(line, format!("`{s}` in column `{}` is not a number", COLUMNS[c]))
-                })?;
+                v[c] = s
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|x| x.is_finite())
+                    .ok_or_else(|| {
+                        OceanError::at(
+                            line,
+                            format!("`{s}` in column `{}` is not a number", COLUMNS[c]),
+                        )
+                    })?;
             }
             let (h, w) = (v[0], v[1]);
             if !(0.0..360.0).contains(&h) {
-                return Err(OceanError::at(line, format!("heading {h} is outside [0, 360)")));
+                return Err(OceanError::at(
+                    line,
+                    format!("heading {h} is outside [0, 360)"),
+                ));
             }
             if w <= 0.0 {
-                return Err(OceanError::at(line, format!("frequency {w} rad/s is not positive")));
+                return Err(OceanError::at(
+                    line,
+                    format!("frequency {w} rad/s is not positive"),
+                ));
             }
             for c in [2, 4, 6] {
                 if v[c] < 0.0 {
-                    return Err(OceanError::at(line, format!("amplitude `{}` = {} is negative", COLUMNS[c], v[c]))
-                        .hint("put the sign in the phase (a negative amplitude is a phase of 180°)"));
+                    return Err(OceanError::at(
+                        line,
+                        format!("amplitude `{}` = {} is negative", COLUMNS[c], v[c]),
+                    )
+                    .hint("put the sign in the phase (a negative amplitude is a phase of 180°)"));
                 }
             }
             if headings.last() != Some(&h) {
                 if let Some(&last) = headings.last() {
                     if h <= last {
-                        return Err(OceanError::at(line, format!("heading {h} after {last}: headings must increase")));
+                        return Err(OceanError::at(
+                            line,
+                            format!("heading {h} after {last}: headings must increase"),
+                        ));
                     }
                     if j != omegas.len() {
-                        return Err(OceanError::at(line, format!("heading {last} has {j} frequencies, the first heading {}", omegas.len())));
+                        return Err(OceanError::at(
+                            line,
+                            format!(
+                                "heading {last} has {j} frequencies, the first heading {}",
+                                omegas.len()
+                            ),
+                        ));
                     }
                 }
                 headings.push(h);
@@ -191,8 +221,14 @@ impl Rao {
                 }
                 omegas.push(w);
             } else if omegas.get(j) != Some(&w) {
-                return Err(OceanError::at(line, format!("frequency {w} where the first heading has {}", omegas.get(j).map_or("no more".to_owned(), f64::to_string)))
-                    .hint("every heading lists the same frequencies"));
+                return Err(OceanError::at(
+                    line,
+                    format!(
+                        "frequency {w} where the first heading has {}",
+                        omegas.get(j).map_or("no more".to_owned(), f64::to_string)
+                    ),
+                )
+                .hint("every heading lists the same frequencies"));
             }
             values.push([
                 (v[2], v[3].to_radians()),
@@ -205,7 +241,10 @@ impl Rao {
             return Err(OceanError::new("the RAO file has no rows"));
         }
         if j != omegas.len() {
-            return Err(OceanError::new(format!("the last heading has {j} frequencies, the first {}", omegas.len())));
+            return Err(OceanError::new(format!(
+                "the last heading has {j} frequencies, the first {}",
+                omegas.len()
+            )));
         }
         Ok(Self {
             headings,
@@ -246,7 +285,11 @@ impl Rao {
             (0, 0, 0.0)
         } else {
             let k = self.headings.partition_point(|&h| h <= b);
-            let (h0, h1) = if k == 0 || k == nh { (nh - 1, 0) } else { (k - 1, k) };
+            let (h0, h1) = if k == 0 || k == nh {
+                (nh - 1, 0)
+            } else {
+                (k - 1, k)
+            };
             let span = (self.headings[h1] - self.headings[h0]).rem_euclid(360.0);
             let from = (b - self.headings[h0]).rem_euclid(360.0);
             (h0, h1, if span > 0.0 { from / span } else { 0.0 })
@@ -298,7 +341,11 @@ heading_deg,omega_rad_s,heave_amp_m_per_m,heave_phase_deg,sway_amp_m_per_m,sway_
         // roll in rad/m; the phase from 170 to −170 goes the short way (through 180)
         let (a, p) = r.at(Dof::Roll, 0.75, 90.0);
         assert!((a - 6f64.to_radians()).abs() < 1e-12);
-        assert!((wrap_deg(p.to_degrees()) - 180.0).abs() < 1e-9, "{}", p.to_degrees());
+        assert!(
+            (wrap_deg(p.to_degrees()) - 180.0).abs() < 1e-9,
+            "{}",
+            p.to_degrees()
+        );
         // beyond the frequencies the ends hold; headings are periodic (315 between 90 and 360=0)
         assert_eq!(r.at(Dof::Sway, 5.0, 0.0).0, 0.2);
         let (a, _) = r.at(Dof::Sway, 0.5, 315.0);
@@ -333,7 +380,11 @@ heading_deg,omega_rad_s,heave_amp_m_per_m,heave_phase_deg,sway_amp_m_per_m,sway_
             r.omegas()
                 .iter()
                 .copied()
-                .max_by(|a, b| r.at(dof, *a, heading).0.total_cmp(&r.at(dof, *b, heading).0))
+                .max_by(|a, b| {
+                    r.at(dof, *a, heading)
+                        .0
+                        .total_cmp(&r.at(dof, *b, heading).0)
+                })
                 .unwrap()
         };
         assert!((0.6..=0.8).contains(&peak(Dof::Heave, 90.0)));

@@ -82,7 +82,9 @@ impl WaveRecord {
         seed: u64,
     ) -> Result<Self, OceanError> {
         if !(duration.is_finite() && duration > 0.0) {
-            return Err(OceanError::new(format!("duration = {duration} s must be positive")));
+            return Err(OceanError::new(format!(
+                "duration = {duration} s must be positive"
+            )));
         }
         if !(dt.is_finite() && dt > 0.0) {
             return Err(OceanError::new(format!("dt = {dt} s must be positive")));
@@ -201,9 +203,15 @@ mod tests {
                 let r = WaveRecord::irregular(spectrum, duration, dt, seed).unwrap();
                 let eta = sample(&r, duration, dt);
                 let hs = 4.0 * analysis::std(&eta);
-                assert!((hs / 2.5 - 1.0).abs() < 0.03, "{spectrum:?} seed {seed}: Hs {hs}");
+                assert!(
+                    (hs / 2.5 - 1.0).abs() < 0.03,
+                    "{spectrum:?} seed {seed}: Hs {hs}"
+                );
                 let tp = analysis::peak_period(&eta, dt);
-                assert!((tp / 9.0 - 1.0).abs() < 0.05, "{spectrum:?} seed {seed}: Tp {tp}");
+                assert!(
+                    (tp / 9.0 - 1.0).abs() < 0.05,
+                    "{spectrum:?} seed {seed}: Tp {tp}"
+                );
                 println!("{spectrum:?} seed {seed}: 4·std {hs:.4} m, Tp {tp:.3} s");
             }
         }
@@ -235,7 +243,9 @@ mod tests {
         assert!(w[0] >= 0.25 * s.omega_p() && w[n - 1] <= 8.0 * s.omega_p());
         // the spacing stays within ±Δω/5 of Δω = 2π/duration
         let dw = 2.0 * PI / 1800.0;
-        assert!(w.windows(2).all(|p| ((p[1] - p[0]) / dw - 1.0).abs() <= 0.2 + 1e-3));
+        assert!(w
+            .windows(2)
+            .all(|p| ((p[1] - p[0]) / dw - 1.0).abs() <= 0.2 + 1e-3));
     }
 
     #[test]

@@ -55,7 +55,14 @@ mod tests {
         let got: Vec<u32> = (0..6).map(|_| r.next_u32()).collect();
         assert_eq!(
             got,
-            [0xa15c_02b7, 0x7b47_f409, 0xba1d_3330, 0x83d2_f293, 0xbfa4_784b, 0xcbed_606e]
+            [
+                0xa15c_02b7,
+                0x7b47_f409,
+                0xba1d_3330,
+                0x83d2_f293,
+                0xbfa4_784b,
+                0xcbed_606e
+            ]
         );
     }
 

@@ -54,8 +54,10 @@ fn check(name: &str, v: f64, lo: f64, hi: f64, unit: &str) -> Result<(), OceanEr
     if v.is_finite() && v > lo && v <= hi {
         Ok(())
     } else {
-        Err(OceanError::new(format!("{name} = {v} {unit} is outside ({lo}, {hi}]"))
-            .hint(format!("{name} is a positive number of {unit}")))
+        Err(
+            OceanError::new(format!("{name} = {v} {unit} is outside ({lo}, {hi}]"))
+                .hint(format!("{name} is a positive number of {unit}")),
+        )
     }
 }
 
@@ -167,7 +169,10 @@ mod tests {
         assert!((4.0 * pm.moment0().sqrt() - 2.5).abs() < 1e-10);
         for gamma in [1.0, 2.0, 3.3, 7.0] {
             let j = Spectrum::jonswap(2.5, 9.0, gamma).unwrap();
-            assert!((4.0 * j.moment0().sqrt() - 2.5).abs() < 1e-10, "γ = {gamma}");
+            assert!(
+                (4.0 * j.moment0().sqrt() - 2.5).abs() < 1e-10,
+                "γ = {gamma}"
+            );
         }
     }
 

@@ -122,8 +122,14 @@ mod tests {
             for dof in [Dof::Heave, Dof::Sway, Dof::Roll] {
                 let (amp, phase) = rao.at(dof, omega, 90.0);
                 let (ga, gp) = fit(|t| m.eval(dof, t).0, omega);
-                assert!((ga - a * amp).abs() < 1e-6 * a * amp.max(1.0), "{dof:?} ω {omega}: {ga} vs {}", a * amp);
-                let dp = ((gp - (phi + phase)) + 3.0 * std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI;
+                assert!(
+                    (ga - a * amp).abs() < 1e-6 * a * amp.max(1.0),
+                    "{dof:?} ω {omega}: {ga} vs {}",
+                    a * amp
+                );
+                let dp = ((gp - (phi + phase)) + 3.0 * std::f64::consts::PI)
+                    .rem_euclid(2.0 * std::f64::consts::PI)
+                    - std::f64::consts::PI;
                 assert!(dp.abs() < 1e-6, "{dof:?} ω {omega}: phase off by {dp}");
             }
         }
@@ -137,7 +143,11 @@ mod tests {
         let rao = Rao::parse(TABLE).unwrap();
         let wave = WaveRecord::regular(1.0, 0.7, 0.0);
         let o = VesselMotion::new(&wave, &rao, 90.0, Point::default());
-        let p = Point { x: 5.0, y: 8.0, z: 12.0 };
+        let p = Point {
+            x: 5.0,
+            y: 8.0,
+            z: 12.0,
+        };
         let m = VesselMotion::new(&wave, &rao, 90.0, p);
         for t in [0.0, 1.7, 4.2] {
             let (h, hd, hdd) = m.eval(Dof::Heave, t);

@@ -73,9 +73,16 @@ pub fn command(a: &Args) -> ExitCode {
         Ok(s) => s,
         Err(e) => return bad(&e.message, &e.hint),
     };
-    let point: Vec<f64> = a.point.split(',').filter_map(|v| v.trim().parse().ok()).collect();
+    let point: Vec<f64> = a
+        .point
+        .split(',')
+        .filter_map(|v| v.trim().parse().ok())
+        .collect();
     if point.len() != 3 || point.iter().any(|v: &f64| !v.is_finite()) {
-        return bad(&format!("--point `{}` is not X,Y,Z", a.point), "--point 5,-8,12 (metres)");
+        return bad(
+            &format!("--point `{}` is not X,Y,Z", a.point),
+            "--point 5,-8,12 (metres)",
+        );
     }
     let point = Point {
         x: point[0],
@@ -100,7 +107,11 @@ pub fn command(a: &Args) -> ExitCode {
                 let at = e.line.map(|l| format!(":{l}")).unwrap_or_default();
                 return bad(
                     &format!("{}{at}: {}", path.display(), e.message),
-                    if e.hint.is_empty() { "docs/sea-states.md describes the RAO file" } else { &e.hint },
+                    if e.hint.is_empty() {
+                        "docs/sea-states.md describes the RAO file"
+                    } else {
+                        &e.hint
+                    },
                 );
             }
         },
@@ -118,7 +129,11 @@ pub fn command(a: &Args) -> ExitCode {
             }
         }
     }
-    let mut text = String::from(if motion.is_some() { "t,eta,heave,sway,roll\n" } else { "t,eta\n" });
+    let mut text = String::from(if motion.is_some() {
+        "t,eta,heave,sway,roll\n"
+    } else {
+        "t,eta\n"
+    });
     for k in 0..n {
         text.push_str(&format!("{},{}", k as f64 * a.dt, eta[k]));
         for c in &cols {
@@ -147,15 +162,27 @@ pub fn command(a: &Args) -> ExitCode {
         let tw: Vec<f64> = (0..=400).map(|k| w1 * f64::from(k) / 400.0).collect();
         let ts: Vec<f64> = tw.iter().map(|&x| spectrum.density(x)).collect();
         let names = ["heave [m]", "sway [m]", "roll [deg]"];
-        let roll_deg: Vec<f64> = cols.get(2).map_or_else(Vec::new, |r| r.iter().map(|v| v.to_degrees()).collect());
-        let mut series = vec![bg_sim::plot::SeaSeries { name: "η [m]", values: &eta }];
+        let roll_deg: Vec<f64> = cols
+            .get(2)
+            .map_or_else(Vec::new, |r| r.iter().map(|v| v.to_degrees()).collect());
+        let mut series = vec![bg_sim::plot::SeaSeries {
+            name: "η [m]",
+            values: &eta,
+        }];
         for (k, (c, name)) in cols.iter().zip(names).enumerate() {
             let values = if k == 2 { &roll_deg } else { c };
             series.push(bg_sim::plot::SeaSeries { name, values });
         }
-        let kind = if a.spectrum == "pm" { "Pierson–Moskowitz".to_owned() } else { format!("JONSWAP γ {}", a.gamma) };
+        let kind = if a.spectrum == "pm" {
+            "Pierson–Moskowitz".to_owned()
+        } else {
+            format!("JONSWAP γ {}", a.gamma)
+        };
         let window = a.duration.min(300.0);
-        let title = format!("{kind}, Hs {} m, Tp {} s, seed {} (record: first {window} s)", a.hs, a.tp, a.seed);
+        let title = format!(
+            "{kind}, Hs {} m, Tp {} s, seed {} (record: first {window} s)",
+            a.hs, a.tp, a.seed
+        );
         match bg_sim::plot::sea_figure(&title, &series, a.dt, window, (&w, &s), (&tw, &ts), path) {
             Ok(p) => say!("{}", p.display()),
             Err(e) => {

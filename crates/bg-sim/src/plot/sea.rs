@@ -48,7 +48,7 @@ pub fn sea_figure(
             y1 = y1.max(*v);
         }
     }
-    if !(y1 > y0) {
+    if y1.partial_cmp(&y0) != Some(std::cmp::Ordering::Greater) {
         (y0, y1) = (-1.0, 1.0);
     }
     let pad = 0.08 * (y1 - y0);
@@ -56,7 +56,14 @@ pub fn sea_figure(
     let s1 = target
         .1
         .iter()
-        .chain(estimate.1.iter().zip(estimate.0).filter(|(_, w)| **w <= w1).map(|(s, _)| s))
+        .chain(
+            estimate
+                .1
+                .iter()
+                .zip(estimate.0)
+                .filter(|(_, w)| **w <= w1)
+                .map(|(s, _)| s),
+        )
         .fold(0.0f64, |a, &b| if b.is_finite() { a.max(b) } else { a });
     let s1 = if s1 > 0.0 { 1.1 * s1 } else { 1.0 };
     {
@@ -96,7 +103,9 @@ pub fn sea_figure(
                 .draw_series(LineSeries::new(pts, color.stroke_width(2)))
                 .map_err(|e| fail(&e))?
                 .label(s.name)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2)));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
+                });
         }
         chart
             .configure_series_labels()
@@ -134,8 +143,15 @@ pub fn sea_figure(
             .draw_series(LineSeries::new(est, PALETTE[0].stroke_width(2)))
             .map_err(|e| fail(&e))?
             .label("record (Welch estimate)")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], PALETTE[0].stroke_width(2)));
-        let tgt: Vec<(f64, f64)> = target.0.iter().zip(target.1).map(|(w, s)| (*w, *s)).collect();
+            .legend(|(x, y)| {
+                PathElement::new(vec![(x, y), (x + 18, y)], PALETTE[0].stroke_width(2))
+            });
+        let tgt: Vec<(f64, f64)> = target
+            .0
+            .iter()
+            .zip(target.1)
+            .map(|(w, s)| (*w, *s))
+            .collect();
         chart
             .draw_series(DashedLineSeries::new(tgt, 8, 4, BLACK.stroke_width(2)))
             .map_err(|e| fail(&e))?

@@ -551,11 +551,13 @@ mod tests {
 
     #[test]
     fn a_not_a_knot_spline_reproduces_a_cubic_with_its_derivatives() {
-        let f = |t: f64| [
-            2.0 - t + 0.5 * t * t - 0.3 * t * t * t,
-            -1.0 + t - 0.9 * t * t,
-            1.0 - 1.8 * t,
-        ];
+        let f = |t: f64| {
+            [
+                2.0 - t + 0.5 * t * t - 0.3 * t * t * t,
+                -1.0 + t - 0.9 * t * t,
+                1.0 - 1.8 * t,
+            ]
+        };
         let times = vec![0.0, 0.4, 1.1, 1.5, 2.6, 3.0, 4.2];
         let values = times.iter().map(|&t| f(t)[0]).collect();
         let s = Series::new(times, values, Interp::Spline).unwrap();
@@ -563,7 +565,10 @@ mod tests {
             let t = f64::from(k) * 0.05;
             let (got, want) = (s.jet(t), f(t));
             for d in 0..3 {
-                assert!((got[d] - want[d]).abs() < 1e-11, "t {t}, derivative {d}: {got:?} vs {want:?}");
+                assert!(
+                    (got[d] - want[d]).abs() < 1e-11,
+                    "t {t}, derivative {d}: {got:?} vs {want:?}"
+                );
             }
         }
         // three samples: their parabola; two: their line
@@ -576,7 +581,9 @@ mod tests {
 
     #[test]
     fn spline_derivatives_match_finite_differences_and_the_spline_is_c2() {
-        let times: Vec<f64> = (0..30).map(|k| f64::from(k) * 0.3 + 0.01 * f64::from(k % 4)).collect();
+        let times: Vec<f64> = (0..30)
+            .map(|k| f64::from(k) * 0.3 + 0.01 * f64::from(k % 4))
+            .collect();
         let values: Vec<f64> = times.iter().map(|t| (1.3 * t).sin() + 0.2 * t).collect();
         let s = Series::new(times.clone(), values, Interp::Spline).unwrap();
         let h = 1e-5;
@@ -593,7 +600,10 @@ mod tests {
         for (i, &tk) in times.iter().enumerate().skip(1).take(times.len() - 2) {
             let (left, right) = (s.jet_on_piece(i, tk), s.jet_on_piece(i + 1, tk));
             for d in 0..3 {
-                assert!((left[d] - right[d]).abs() < 1e-9, "sample {i}, derivative {d}");
+                assert!(
+                    (left[d] - right[d]).abs() < 1e-9,
+                    "sample {i}, derivative {d}"
+                );
             }
         }
     }

@@ -52,7 +52,10 @@ impl Integrator {
         ParamError::finite("initial", initial)?;
         ParamError::positive("reset_time", reset_time)?;
         if min.is_nan() || max.is_nan() || min > max {
-            return Err(ParamError::shape("min", format!("min = {min} must not exceed max = {max}")));
+            return Err(ParamError::shape(
+                "min",
+                format!("min = {min} must not exceed max = {max}"),
+            ));
         }
         if !(min..=max).contains(&initial) {
             return Err(ParamError::shape(
@@ -122,7 +125,11 @@ impl Element for Integrator {
     fn stage_partials(&self, _: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
         let y = io.states()[0];
         let inside = y > self.min && y < self.max;
-        jac.set(jac.row(Slot::Output(0), 0), jac.state_col(0), if inside { 1.0 } else { 0.0 });
+        jac.set(
+            jac.row(Slot::Output(0), 0),
+            jac.state_col(0),
+            if inside { 1.0 } else { 0.0 },
+        );
         true
     }
     fn derivative_partials(&self, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
@@ -147,9 +154,15 @@ pub const KIND: KindDecl = KindDecl::element(
         ParamDecl::number("initial", "", "initial value and reset value").default(0.0),
         ParamDecl::number("min", "", "lower limit").default(f64::NEG_INFINITY),
         ParamDecl::number("max", "", "upper limit").default(f64::INFINITY),
-        ParamDecl::modulated("reset", "", "reset signal: y relaxes to `initial` while it is ≥ 0.5")
-            .default(0.0),
-        ParamDecl::number("reset_time", "s", "time constant of the reset").default(1e-3).positive(),
+        ParamDecl::modulated(
+            "reset",
+            "",
+            "reset signal: y relaxes to `initial` while it is ≥ 0.5",
+        )
+        .default(0.0),
+        ParamDecl::number("reset_time", "s", "time constant of the reset")
+            .default(1e-3)
+            .positive(),
     ],
     |p| {
         let reset = if p.has("reset") {
@@ -191,7 +204,8 @@ mod tests {
         g.add("r", crate::Input::new(spec).unwrap()).unwrap();
         let mut eqs = StateEquations::new(assign_causality(g).unwrap()).unwrap();
         if let Some(s) = reset {
-            eqs.set_input_series(eqs.input_index("r").unwrap(), s).unwrap();
+            eqs.set_input_series(eqs.input_index("r").unwrap(), s)
+                .unwrap();
         }
         let x0 = eqs.initial_state();
         let settings = Settings {
@@ -212,7 +226,17 @@ mod tests {
     #[test]
     fn integrates_exactly_a_polynomial() {
         // ∫₀² (1 + 3t²) dt = 2 + 8
-        let y = run(Integrator::new(law(|t| 1.0 + 3.0 * t * t), 0.5, (f64::NEG_INFINITY, f64::INFINITY), None, 1e-3).unwrap(), 2.0);
+        let y = run(
+            Integrator::new(
+                law(|t| 1.0 + 3.0 * t * t),
+                0.5,
+                (f64::NEG_INFINITY, f64::INFINITY),
+                None,
+                1e-3,
+            )
+            .unwrap(),
+            2.0,
+        );
         assert!((y - 10.5).abs() < 1e-8, "{y}");
     }
 
@@ -221,7 +245,10 @@ mod tests {
         // u = cos(t): y = sin(t) would reach 1 at π/2; capped at 0.5 from t = π/6 until u
         // turns negative at π/2, then y = 0.5 + sin(t) − 1 (no stored excess): at t = π,
         // y = −0.5 (a windup integrator would give sin(π) = 0).
-        let y = run(Integrator::new(law(f64::cos), 0.0, (-10.0, 0.5), None, 1e-3).unwrap(), std::f64::consts::PI);
+        let y = run(
+            Integrator::new(law(f64::cos), 0.0, (-10.0, 0.5), None, 1e-3).unwrap(),
+            std::f64::consts::PI,
+        );
         assert!((y + 0.5).abs() < 1e-5, "{y}");
     }
 
@@ -231,7 +258,13 @@ mod tests {
         // then integrates 1 again: y(2) = 2 + 0.95
         let reset = Param::modulated(vec!["r".into()], |_, u| u[0]);
         let r = crate::Series::new(vec![1.0, 1.05], vec![1.0, 0.0], crate::Interp::Hold).unwrap();
-        let el = Integrator::new(law(|_| 1.0), 2.0, (f64::NEG_INFINITY, f64::INFINITY), Some(reset), 1e-3);
+        let el = Integrator::new(
+            law(|_| 1.0),
+            2.0,
+            (f64::NEG_INFINITY, f64::INFINITY),
+            Some(reset),
+            1e-3,
+        );
         let y = run_with(el.unwrap(), 2.0, Some(r));
         assert!((y - 2.95).abs() < 1e-4, "{y}");
     }

@@ -93,11 +93,16 @@ mod tests {
     fn a_spring_fed_by_the_source_integrates_back_the_position() {
         let x = Motion::law(|t| {
             let w = 2.0;
-            [0.3 * (w * t).sin() + 0.1 * t * t, 0.3 * w * (w * t).cos() + 0.2 * t, -0.3 * w * w * (w * t).sin() + 0.2]
+            [
+                0.3 * (w * t).sin() + 0.1 * t * t,
+                0.3 * w * (w * t).cos() + 0.2 * t,
+                -0.3 * w * w * (w * t).sin() + 0.2,
+            ]
         });
         let mut g = BondGraph::new();
         g.add("tip", PositionSource::new(x.clone())).unwrap();
-        g.add("spring", crate::Capacitor::new(1.0, 0.0).unwrap()).unwrap();
+        g.add("spring", crate::Capacitor::new(1.0, 0.0).unwrap())
+            .unwrap();
         g.connect_names("tip", "spring").unwrap();
         let mut eqs = StateEquations::new(assign_causality(g).unwrap()).unwrap();
         let x0 = eqs.initial_state();
@@ -110,7 +115,11 @@ mod tests {
         let run = simulate(&mut eqs, &x0, &settings, &[], vec![]);
         assert!(run.error.is_none(), "{:?}", run.error);
         let want = x.eval(3.0)[0] - x.eval(0.0)[0];
-        assert!((run.x_final[0] - want).abs() < 1e-8, "{} vs {want}", run.x_final[0]);
+        assert!(
+            (run.x_final[0] - want).abs() < 1e-8,
+            "{} vs {want}",
+            run.x_final[0]
+        );
     }
 
     #[test]

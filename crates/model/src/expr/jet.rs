@@ -137,8 +137,12 @@ fn pow(a: Jet, b: Jet) -> Jet {
     if b[1] == 0.0 && b[2] == 0.0 {
         let c = b[0];
         let v = a[0].powf(c);
-        let d1 = if c == 0.0 { 0.0 } else { c * a[0].powf(c - 1.0) };
-        let d2 = if c == 0.0 || c == 1.0 {
+        let d1 = if c == 0.0 {
+            0.0
+        } else {
+            c * a[0].powf(c - 1.0)
+        };
+        let d2 = if c == 0.0 || c - 1.0 == 0.0 {
             0.0
         } else {
             c * (c - 1.0) * a[0].powf(c - 2.0)
@@ -312,8 +316,14 @@ mod tests {
                 let [x, v, a] = m.eval(t);
                 let h = 1e-5;
                 let (p, q) = (m.eval(t + h), m.eval(t - h));
-                assert!((v - (p[0] - q[0]) / (2.0 * h)).abs() < 1e-6 * (1.0 + v.abs()), "{src}: ẋ at {t}");
-                assert!((a - (p[1] - q[1]) / (2.0 * h)).abs() < 1e-6 * (1.0 + a.abs()), "{src}: ẍ at {t}");
+                assert!(
+                    (v - (p[0] - q[0]) / (2.0 * h)).abs() < 1e-6 * (1.0 + v.abs()),
+                    "{src}: ẋ at {t}"
+                );
+                assert!(
+                    (a - (p[1] - q[1]) / (2.0 * h)).abs() < 1e-6 * (1.0 + a.abs()),
+                    "{src}: ẍ at {t}"
+                );
                 let plain = Expr::parse(src).unwrap().eval(&|n| match n {
                     "A" => Some(0.5),
                     "w" => Some(t.sin()),
@@ -327,12 +337,21 @@ mod tests {
 
     #[test]
     fn constants_stand_still_and_unknown_names_or_tables_are_refused() {
-        assert_eq!(motion("2*A + pi").constant(), Some(1.0 + std::f64::consts::PI));
+        assert_eq!(
+            motion("2*A + pi").constant(),
+            Some(1.0 + std::f64::consts::PI)
+        );
         let none = |_: &str| None::<f64>;
         let no_input = |_: &str| None::<Motion>;
-        let e = Expr::parse("spring.q + t").unwrap().motion(&none, &no_input).unwrap_err();
+        let e = Expr::parse("spring.q + t")
+            .unwrap()
+            .motion(&none, &no_input)
+            .unwrap_err();
         assert!(e.contains("spring.q"), "{e}");
-        let e = Expr::parse_with("lut(t)", &[("lut".to_owned(), 1)]).unwrap().motion(&none, &no_input).unwrap_err();
+        let e = Expr::parse_with("lut(t)", &[("lut".to_owned(), 1)])
+            .unwrap()
+            .motion(&none, &no_input)
+            .unwrap_err();
         assert!(e.contains("lut"), "{e}");
     }
 }

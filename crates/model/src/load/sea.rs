@@ -29,8 +29,8 @@ use crate::error::{clip, ModelError};
 use crate::expr::Expr;
 
 const KEYS: &[&str] = &[
-    "hs", "tp", "spectrum", "gamma", "seed", "duration", "dt", "rao", "heading", "dof", "x",
-    "y", "z",
+    "hs", "tp", "spectrum", "gamma", "seed", "duration", "dt", "rao", "heading", "dof", "x", "y",
+    "z",
 ];
 
 /// The motion of the sea input `name` from its `sea` table; `err` makes an error at the
@@ -49,12 +49,14 @@ pub(super) fn motion(
     for k in table.keys() {
         if !KEYS.contains(&k.as_str()) {
             let close = bondgraph::kind::suggest(k, KEYS.iter().copied());
-            return Err(err(format!("`sea` of input `{name}` has no key `{}`", clip(k))).hint(
-                match close {
-                    Some(c) => format!("did you mean `{c}`? keys: {}", KEYS.join(", ")),
-                    None => format!("keys: {}", KEYS.join(", ")),
-                },
-            ));
+            return Err(
+                err(format!("`sea` of input `{name}` has no key `{}`", clip(k))).hint(
+                    match close {
+                        Some(c) => format!("did you mean `{c}`? keys: {}", KEYS.join(", ")),
+                        None => format!("keys: {}", KEYS.join(", ")),
+                    },
+                ),
+            );
         }
     }
     let number = |key: &str, default: Option<f64>| -> Result<f64, ModelError> {
@@ -73,19 +75,27 @@ pub(super) fn motion(
                     err(format!("`sea.{key}` of input `{name}`: {m}"))
                         .hint("a number or an expression of [parameters]")
                 })?,
-            Some(_) => return Err(err(format!("`sea.{key}` of input `{name}` must be a number"))),
+            Some(_) => {
+                return Err(err(format!(
+                    "`sea.{key}` of input `{name}` must be a number"
+                )))
+            }
         };
         if x.is_finite() {
             Ok(x)
         } else {
-            Err(err(format!("`sea.{key}` of input `{name}` is {x}, not finite")))
+            Err(err(format!(
+                "`sea.{key}` of input `{name}` is {x}, not finite"
+            )))
         }
     };
     let text = |key: &str| -> Result<Option<String>, ModelError> {
         match table.get(key) {
             None => Ok(None),
             Some(toml::Value::String(s)) => Ok(Some(s.clone())),
-            Some(_) => Err(err(format!("`sea.{key}` of input `{name}` must be a string"))),
+            Some(_) => Err(err(format!(
+                "`sea.{key}` of input `{name}` must be a string"
+            ))),
         }
     };
     let ocean = |e: bg_ocean::OceanError| {
@@ -100,20 +110,26 @@ pub(super) fn motion(
         None | Some("jonswap") => Spectrum::jonswap(hs, tp, number("gamma", Some(3.3))?),
         Some("pm") => {
             if table.contains_key("gamma") {
-                return Err(err(format!("`sea` of input `{name}` gives `gamma` to a Pierson–Moskowitz spectrum"))
-                    .hint("drop `gamma`, or write spectrum = \"jonswap\""));
+                return Err(err(format!(
+                    "`sea` of input `{name}` gives `gamma` to a Pierson–Moskowitz spectrum"
+                ))
+                .hint("drop `gamma`, or write spectrum = \"jonswap\""));
             }
             Spectrum::pierson_moskowitz(hs, tp)
         }
         Some(s) => {
-            return Err(err(format!("`sea.spectrum` of input `{name}` is `{}`", clip(s)))
-                .hint("`spectrum` is \"jonswap\" (the default) or \"pm\""))
+            return Err(
+                err(format!("`sea.spectrum` of input `{name}` is `{}`", clip(s)))
+                    .hint("`spectrum` is \"jonswap\" (the default) or \"pm\""),
+            )
         }
     }
     .map_err(ocean)?;
     let seed = number("seed", Some(0.0))?;
     if seed < 0.0 || seed.fract() != 0.0 || seed > 9.0e15 {
-        return Err(err(format!("`sea.seed` of input `{name}` = {seed} must be a whole number ≥ 0")));
+        return Err(err(format!(
+            "`sea.seed` of input `{name}` = {seed} must be a whole number ≥ 0"
+        )));
     }
     let record = WaveRecord::irregular(
         spectrum,
@@ -129,7 +145,9 @@ pub(super) fn motion(
             Some(Rao::read(&path).map_err(|e| {
                 let mut m = err(format!(
                     "`sea.rao` of input `{name}`: {}{}",
-                    e.line.map(|l| format!("{}:{l}: ", path.display())).unwrap_or_default(),
+                    e.line
+                        .map(|l| format!("{}:{l}: ", path.display()))
+                        .unwrap_or_default(),
                     e.message
                 ));
                 if !e.hint.is_empty() {
@@ -227,12 +245,17 @@ t_end = 1.0
             ("{ hs = 2.5, tp = 9, dof = \"heave\" }", "gives no `rao`"),
             ("{ hs = 2.5, tp = 9, rao = \"nowhere.csv\" }", "cannot read"),
             ("{ hs = -1, tp = 9 }", "Hs"),
-            ("{ hs = 2.5, tp = 9, spectrum = \"pm\", gamma = 2 }", "Pierson"),
+            (
+                "{ hs = 2.5, tp = 9, spectrum = \"pm\", gamma = 2 }",
+                "Pierson",
+            ),
         ] {
             let text = format!(
                 "[inputs]\neta = {{ sea = {sea} }}\n[elements]\nm = {{ kind = \"I\", m = 1.0 }}\nf = {{ kind = \"Se\", e = \"eta\" }}\n[bonds]\nb = \"f -> m\"\n"
             );
-            let e = Model::from_text("sea.toml", &text, &crate::Registry::with_core(), &[]).unwrap_err().to_string();
+            let e = Model::from_text("sea.toml", &text, &crate::Registry::with_core(), &[])
+                .unwrap_err()
+                .to_string();
             assert!(e.contains(want), "{sea}: {e}");
             assert!(e.contains("sea.toml:2"), "{sea}: {e}");
         }
@@ -287,7 +310,10 @@ b = "tip -> spring"
         let mut csv = String::from("t,y\n");
         for k in 0..=10 {
             let t = 0.5 * f64::from(k);
-            csv.push_str(&format!("{t},{}\n", 1.0 + t - 0.2 * t * t + 0.03 * t * t * t));
+            csv.push_str(&format!(
+                "{t},{}\n",
+                1.0 + t - 0.2 * t * t + 0.03 * t * t * t
+            ));
         }
         std::fs::write(dir.path().join("y.csv"), csv).unwrap();
         let file = dir.path().join("m.toml");
@@ -304,9 +330,14 @@ b = "tip -> spring"
         let f = |t: f64| 1.0 + t - 0.2 * t * t + 0.03 * t * t * t;
         assert!((q - (f(4.0) - f(0.0))).abs() < 1e-8, "{q}");
         let bad = text.replace("x = \"y\"", "x = \"spring.q\"");
-        let e = Model::from_text(&file.display().to_string(), &bad, &crate::Registry::with_core(), &[])
-            .unwrap_err()
-            .to_string();
+        let e = Model::from_text(
+            &file.display().to_string(),
+            &bad,
+            &crate::Registry::with_core(),
+            &[],
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("spring.q") && e.contains("spline"), "{e}");
     }
 }
