@@ -14,8 +14,8 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use commands::fatigue;
 use commands::{
-    bench, check, compare, energy, fmu, graph, kinds, linearize, modes, plot, reduce, run, stress,
-    sweep, FAILED,
+    bench, check, compare, energy, fmu, graph, kinds, linearize, modes, plot, reduce, run, sea,
+    stress, sweep, FAILED,
 };
 
 #[derive(Parser)]
@@ -82,6 +82,10 @@ enum Command {
     /// Rainflow-count a column of a results CSV (ASTM E1049-85) and its Palmgren–Miner
     /// damage on an S–N curve (EN 1993-1-9, DNV-RP-C203 presets or explicit).
     Fatigue(fatigue::Args),
+    /// An irregular sea state (JONSWAP or Pierson–Moskowitz) as a CSV time series: the wave
+    /// elevation and, with --rao, the vessel's heave, sway and roll at a point; --plot draws
+    /// the record and its spectrum against the target (docs/sea-states.md).
+    Sea(sea::Args),
 }
 
 fn main() -> ExitCode {
@@ -131,5 +135,6 @@ fn dispatch(command: Command) -> ExitCode {
         Command::Fmu(a) => fmu::command(&a),
         Command::Stress(a) => stress::command(&a),
         Command::Fatigue(a) => fatigue::command(&a),
+        Command::Sea(a) => sea::command(&a),
     }
 }

@@ -16,6 +16,7 @@ mod fatigue;
 mod figure;
 mod quick;
 mod results;
+mod sea;
 mod work_precision;
 
 use std::path::PathBuf;
@@ -31,6 +32,7 @@ pub use fatigue::fatigue;
 pub use figure::{draw, draw_all};
 pub use quick::quick_look;
 pub use results::{not_a_regular_file, Results, PLOT_ROWS};
+pub use sea::{sea_figure, SeaSeries};
 pub use work_precision::{work_precision, WorkPrecisionLine};
 
 /// Why the figures could not be drawn.

@@ -48,6 +48,8 @@ pub struct ElementSpec<'a> {
     pub(crate) inputs: &'a [String],
     /// The model's `[tables]`, callable in expressions.
     pub(crate) tables: Arc<Tables>,
+    /// The `[inputs]` whose time derivatives are known, for [`Params::motion`].
+    pub(crate) motions: Arc<IndexMap<String, bondgraph::Motion>>,
     /// The `[parameters]` written with a unit: its unit and how it was written.
     pub(crate) param_units: Arc<ParamUnits>,
 }
@@ -104,6 +106,7 @@ impl<'a> ElementSpec<'a> {
             used_constants,
             inputs: &[],
             tables: Arc::new(Tables::default()),
+            motions: Arc::default(),
             param_units: Arc::default(),
         }
     }
@@ -482,6 +485,7 @@ impl<'a> ElementSpec<'a> {
             used_constants: self.used_constants,
             inputs: self.inputs,
             tables: Arc::clone(&self.tables),
+            motions: Arc::clone(&self.motions),
             param_units: Arc::clone(&self.param_units),
         };
         spec.validate()?;

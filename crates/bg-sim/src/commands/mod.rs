@@ -19,6 +19,7 @@ pub mod modes;
 pub mod plot;
 pub mod reduce;
 pub mod run;
+pub mod sea;
 pub mod stress;
 pub mod sweep;
 

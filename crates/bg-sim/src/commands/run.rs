@@ -97,7 +97,7 @@ impl InputOptions {
         };
         let interp = bondgraph::Interp::parse(&self.interp).ok_or_else(|| {
             format!(
-                "--inputs-interp {}: not an interpolation\n  hint: linear or hold",
+                "--inputs-interp {}: not an interpolation\n  hint: linear, hold or spline",
                 self.interp
             )
         })?;

@@ -63,6 +63,12 @@ pub trait Params {
     fn vector(&self, key: &str) -> Result<Vec<f64>, BuildError>;
     /// A matrix of expressions.
     fn matrix(&self, key: &str) -> Result<MatrixParam, BuildError>;
+    /// A prescribed motion: x(t) with exact ẋ, ẍ ([`crate::Motion`]), from an expression of
+    /// time (declared as a modulated parameter). The default reads a constant; the model
+    /// loader compiles expressions of `t`, parameters and inputs with known derivatives.
+    fn motion(&self, key: &str) -> Result<crate::Motion, BuildError> {
+        self.number(key).map(crate::Motion::Const)
+    }
     /// A nested table, `None` when absent.
     fn table(&self, key: &str) -> Result<Option<Box<dyn Params + '_>>, BuildError>;
     /// A list of nested tables (empty when absent).

@@ -98,6 +98,7 @@ impl Source {
         );
         spec.inputs = &input_names;
         spec.tables = std::sync::Arc::clone(&self.tables);
+        spec.motions = std::sync::Arc::new(super::inputs::motions(&self.inputs));
         spec.param_units = std::sync::Arc::clone(&self.param_units);
         spec.validate().map_err(|e| spec.locate(e))?;
         let built = match info.build {
