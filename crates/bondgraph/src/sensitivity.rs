@@ -134,6 +134,9 @@ impl SensitivityRhs for StageTerms<'_> {
             }
         }
     }
+    fn end_jacobian(&self) -> Option<&DMatrix<f64>> {
+        Some(&self.jac[2])
+    }
     fn apply(&mut self, stage: usize, k: usize, s: &[f64], out: &mut [f64]) {
         let n = self.n;
         out.copy_from_slice(&self.dfdp[stage][k * n..(k + 1) * n]);

@@ -18,6 +18,7 @@ pub mod modes;
 pub mod plot;
 pub mod reduce;
 pub mod run;
+pub mod sensitivity;
 pub mod sweep;
 
 /// Exit statuses (README, "Exit status").

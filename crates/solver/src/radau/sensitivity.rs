@@ -22,7 +22,8 @@
 //! whole runs). Dense output: the stages' collocation polynomial, as for the state.
 //! Nothing here allocates after [`Sensitivities::new`].
 
-use super::{Radau5, RadauError};
+use super::linear::Linear;
+use super::{DMatrix, Radau5, RadauError};
 
 /// What the sensitivity equations need of the problem on each stage point of an accepted
 /// step.
@@ -34,11 +35,20 @@ pub trait SensitivityRhs {
     fn prepare(&mut self, stage: usize, t: f64, y: &[f64]);
     /// `out = J·s + ∂f/∂p_k` at the prepared stage `stage`.
     fn apply(&mut self, stage: usize, k: usize, s: &[f64], out: &mut [f64]);
+    /// The dense Jacobian at the last stage point (the step's end), if prepared: when the
+    /// step's LU is too far from the stages' Jacobians for the iteration to converge, the
+    /// integrator takes it (it is current there) and factorises anew.
+    fn end_jacobian(&self) -> Option<&DMatrix<f64>> {
+        None
+    }
 }
 
-/// Iterations of the stage solve before giving up (the linear system converges at the
-/// state's Newton rate, usually ≤ 0.03: three to six iterations to round-off).
-const MAX_ITERATIONS: usize = 30;
+/// Iterations of the stage solve before the LU is renewed (the linear system converges at
+/// the state's Newton rate, usually ≤ 0.03: a few iterations), and after.
+const MAX_ITERATIONS: usize = 12;
+const MAX_ITERATIONS_RENEWED: usize = 40;
+/// Convergence rate above which the LU is renewed at once.
+const SLOW: f64 = 0.3;
 
 /// The sensitivities of one run: n states × `n_params` columns, stored column by column
 /// (`s[k·n + i]` = ∂yᵢ/∂p_k).
@@ -70,6 +80,8 @@ pub struct Sensitivities {
     pub iterations: usize,
     /// Steps the sensitivities followed.
     pub steps: usize,
+    /// Times the step's LU was renewed for them.
+    pub renewals: usize,
 }
 
 impl Sensitivities {
@@ -106,6 +118,7 @@ impl Sensitivities {
             dim: buf(n),
             iterations: 0,
             steps: 0,
+            renewals: 0,
         })
     }
 
@@ -158,6 +171,8 @@ impl Sensitivities {
             sys.prepare(j, t0 + tab.c[j] * h, &self.ytmp);
         }
         let (fac1, alphn, betan) = (tab.gamma / h, tab.alpha / h, tab.beta / h);
+        // Converged to well below the state's own tolerance.
+        let tol = (1e-3 * radau.rtol).clamp(1e-13, 1e-8);
         self.s_prev.copy_from_slice(&self.s);
         for k in 0..self.np {
             let col = k * n..(k + 1) * n;
@@ -165,50 +180,87 @@ impl Sensitivities {
                 self.z[j].fill(0.0);
                 self.w[j].fill(0.0);
             }
-            let sp = &self.s_prev[col.clone()];
-            let scale = sp.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             let mut converged = false;
-            for _ in 0..MAX_ITERATIONS {
-                for j in 0..3 {
-                    for ((st, s), z) in self.stmp.iter_mut().zip(sp).zip(&self.z[j]) {
-                        *st = s + z;
+            let mut renewed = false;
+            loop {
+                let sp = &self.s_prev[col.clone()];
+                let scale = sp.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                let mut last = f64::INFINITY;
+                let limit = if renewed {
+                    MAX_ITERATIONS_RENEWED
+                } else {
+                    MAX_ITERATIONS
+                };
+                for it in 0..limit {
+                    for j in 0..3 {
+                        for ((st, s), z) in self.stmp.iter_mut().zip(sp).zip(&self.z[j]) {
+                            *st = s + z;
+                        }
+                        sys.apply(j, k, &self.stmp, &mut self.g[j]);
                     }
-                    sys.apply(j, k, &self.stmp, &mut self.g[j]);
+                    let [g0, g1, g2] = &self.g;
+                    let [w0, w1, w2] = &self.w;
+                    for i in 0..n {
+                        let (a1, a2, a3) = (g0[i], g1[i], g2[i]);
+                        let gk =
+                            |m: usize| tab.ti[m][0] * a1 + tab.ti[m][1] * a2 + tab.ti[m][2] * a3;
+                        let (v1, v2, v3) = (w0[i], w1[i], w2[i]);
+                        self.dr[i] = gk(0) - fac1 * v1;
+                        self.dre[i] = gk(1) - (alphn * v2 - betan * v3);
+                        self.dim[i] = gk(2) - (betan * v2 + alphn * v3);
+                    }
+                    radau.lin.solve_real(&mut self.dr);
+                    radau.lin.solve_complex(&mut self.dre, &mut self.dim);
+                    self.iterations += 1;
+                    let (mut dmax, mut zmax) = (0.0f64, 0.0f64);
+                    let [w0, w1, w2] = &mut self.w;
+                    let [z0, z1, z2] = &mut self.z;
+                    for i in 0..n {
+                        let (a, b, c) = (self.dr[i], self.dre[i], self.dim[i]);
+                        dmax = dmax.max(a.abs()).max(b.abs()).max(c.abs());
+                        w0[i] += a;
+                        w1[i] += b;
+                        w2[i] += c;
+                        let (v1, v2, v3) = (w0[i], w1[i], w2[i]);
+                        let zk = |m: usize| tab.t[m][0] * v1 + tab.t[m][1] * v2 + tab.t[m][2] * v3;
+                        (z0[i], z1[i], z2[i]) = (zk(0), zk(1), zk(2));
+                        zmax = zmax.max(z0[i].abs()).max(z1[i].abs()).max(z2[i].abs());
+                    }
+                    if !dmax.is_finite() {
+                        break;
+                    }
+                    if dmax <= tol * (scale + zmax) || dmax == 0.0 {
+                        converged = true;
+                        break;
+                    }
+                    if !renewed && it >= 2 && dmax > SLOW * last {
+                        break;
+                    }
+                    last = dmax;
                 }
-                let [g0, g1, g2] = &self.g;
-                let [w0, w1, w2] = &self.w;
-                for i in 0..n {
-                    let (a1, a2, a3) = (g0[i], g1[i], g2[i]);
-                    let gk = |m: usize| tab.ti[m][0] * a1 + tab.ti[m][1] * a2 + tab.ti[m][2] * a3;
-                    let (v1, v2, v3) = (w0[i], w1[i], w2[i]);
-                    self.dr[i] = gk(0) - fac1 * v1;
-                    self.dre[i] = gk(1) - (alphn * v2 - betan * v3);
-                    self.dim[i] = gk(2) - (betan * v2 + alphn * v3);
-                }
-                radau.lin.solve_real(&mut self.dr);
-                radau.lin.solve_complex(&mut self.dre, &mut self.dim);
-                self.iterations += 1;
-                let (mut dmax, mut zmax) = (0.0f64, 0.0f64);
-                let [w0, w1, w2] = &mut self.w;
-                let [z0, z1, z2] = &mut self.z;
-                for i in 0..n {
-                    let (a, b, c) = (self.dr[i], self.dre[i], self.dim[i]);
-                    dmax = dmax.max(a.abs()).max(b.abs()).max(c.abs());
-                    w0[i] += a;
-                    w1[i] += b;
-                    w2[i] += c;
-                    let (v1, v2, v3) = (w0[i], w1[i], w2[i]);
-                    let zk = |m: usize| tab.t[m][0] * v1 + tab.t[m][1] * v2 + tab.t[m][2] * v3;
-                    (z0[i], z1[i], z2[i]) = (zk(0), zk(1), zk(2));
-                    zmax = zmax.max(z0[i].abs()).max(z1[i].abs()).max(z2[i].abs());
-                }
-                if !dmax.is_finite() {
+                if converged || renewed {
                     break;
                 }
-                if dmax <= 1e-13 * (scale + zmax) || dmax == 0.0 {
-                    converged = true;
+                // Too slow with the step's LU: renew it from the Jacobian at the step's end.
+                renewed = true;
+                let Some(jac) = sys.end_jacobian() else { break };
+                let Linear::Dense { jac: j, .. } = &mut radau.lin else {
+                    break;
+                };
+                j.copy_from(jac);
+                if radau.factorise(h).is_err() {
+                    radau.lu_h = None;
+                    radau.need_jac = true;
                     break;
                 }
+                radau.lu_h = Some(h);
+                radau.jac_current = true;
+                radau.need_jac = false;
+                for j in 0..3 {
+                    self.z[j].fill(0.0);
+                    self.w[j].fill(0.0);
+                }
+                self.renewals += 1;
             }
             if !converged {
                 return Err(RadauError::NewtonDiverged { t: t0, h });
