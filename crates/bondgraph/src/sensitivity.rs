@@ -267,7 +267,15 @@ pub fn simulate_sensitivities(
     let mut next_row = 0usize;
     let mut xi = vec![0.0; n];
     let mut si = vec![0.0; n * np];
-    let mut run = SensitivityRun::default();
+    // every row's storage at once: nothing grows while stepping
+    let rows_total = n_grid + 2;
+    let m = outputs.len();
+    let mut run = SensitivityRun {
+        t: Vec::with_capacity(rows_total),
+        y: Vec::with_capacity(rows_total * m),
+        dy_dp: Vec::with_capacity(rows_total * m * np),
+        ..SensitivityRun::default()
+    };
     loop {
         // Events due now, on the model and on every twin alike.
         while let Some(ev) = events.next_if(|e| e.t <= t || same_time(e.t, t)) {
