@@ -10,6 +10,7 @@
 //!   chamber, a payload mass into the arm's mass matrix), so it has no seed in the plan;
 //!   the twin's right-hand side at the same (t, x) differences it, one-sided, with
 //!   h_k = 2⁻²⁶·max(|p_k|, 10⁻³) (relative error about 10⁻⁸).
+//!
 //! Output sensitivities are the directional difference of the twin's outputs,
 //! (y(t, x + h_k s_k; p + h_k) − y(t, x; p))/h_k, which carries both ∂y/∂x·s and ∂y/∂p.
 //! Events (parameter switches) are applied to every twin at the same time, each with its
