@@ -17,6 +17,7 @@ mod figure;
 mod quick;
 mod results;
 mod sea;
+mod sensitivity;
 mod work_precision;
 
 use std::path::PathBuf;
@@ -33,6 +34,7 @@ pub use figure::{draw, draw_all};
 pub use quick::quick_look;
 pub use results::{not_a_regular_file, Results, PLOT_ROWS};
 pub use sea::{sea_figure, SeaSeries};
+pub use sensitivity::{sensitivity_bars, SensitivityBar};
 pub use work_precision::{work_precision, WorkPrecisionLine};
 
 /// Why the figures could not be drawn.

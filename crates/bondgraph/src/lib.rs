@@ -96,6 +96,7 @@ pub mod local_jacobian;
 pub mod modes;
 pub mod motion;
 pub mod partials_check;
+pub mod sensitivity;
 /// The Radau IIA integrator, from the solver crate (`bg-solver`), re-exported.
 pub use bg_solver::radau;
 pub mod simulate;

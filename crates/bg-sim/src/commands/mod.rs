@@ -20,6 +20,7 @@ pub mod plot;
 pub mod reduce;
 pub mod run;
 pub mod sea;
+pub mod sensitivity;
 pub mod stress;
 pub mod sweep;
 
