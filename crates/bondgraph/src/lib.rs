@@ -94,6 +94,7 @@ pub mod kinds;
 pub mod linearize;
 pub mod local_jacobian;
 pub mod modes;
+pub mod motion;
 pub mod partials_check;
 /// The Radau IIA integrator, from the solver crate (`bg-solver`), re-exported.
 pub use bg_solver::radau;
@@ -120,6 +121,7 @@ pub use kind::{BuildError, Composite, KindDecl, ParamDecl, Params};
 pub use linearize::{linearize, BodePoint, Linearization, MAX_BODE_STATES, MAX_LINEARIZE_STATES};
 pub use local_jacobian::{LocalJacobian, LocalShape};
 pub use modes::{modes, modes_of, stiffness_ratio, Mode, ModesError, MAX_MODES_STATES};
+pub use motion::Motion;
 /// The dense matrix type of [`StateEquations::jacobian`].
 pub use nalgebra::DMatrix;
 pub use partials_check::check_partials;

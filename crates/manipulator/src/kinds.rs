@@ -24,6 +24,7 @@
 //! lumped_damping = "c_c"              # N·s/m, with "springs"
 //! paper_reactions = false             # also publish rho{k}_paper (springs only)
 //! geometric_stiffening = false        # keep the axial shortening of the bent links
+//! base = { y = "0.5*sin(0.7*t)", roll = "0.02*sin(0.5*t)" }   # a moving base (default: fixed)
 //! ```
 //!
 //! Links are numbered from 1 as in the paper. A link table has `type` = `"beam"` (length, E,
@@ -154,6 +155,27 @@ const LUMPED_MASS: &[ParamDecl] = &[
     ParamDecl::number("mass", "kg", "mass").positive(),
 ];
 
+const BASE: &[ParamDecl] = &[
+    ParamDecl::modulated(
+        "x",
+        "m",
+        "horizontal position of joint 1, an expression of t",
+    )
+    .default(0.0),
+    ParamDecl::modulated(
+        "y",
+        "m",
+        "vertical position of joint 1 (up), an expression of t",
+    )
+    .default(0.0),
+    ParamDecl::modulated(
+        "roll",
+        "rad",
+        "roll of the base frame (counter-clockwise), an expression of t",
+    )
+    .default(0.0),
+];
+
 /// Kind `manipulator.planar_arm`.
 pub const PLANAR_ARM: KindDecl = KindDecl::composite(
     "manipulator.planar_arm",
@@ -176,6 +198,7 @@ pub const PLANAR_ARM: KindDecl = KindDecl::composite(
         ParamDecl::number("lumped_damping", "N·s/m", "spring damping of lumped masses (with \"springs\")").non_negative().default(0.0),
         ParamDecl::flag("paper_reactions", false, "also publish rho{k}_paper (springs only)"),
         ParamDecl::flag("geometric_stiffening", false, "keep the axial shortening of bent links (axial-force stiffening; docs/manipulator.md)"),
+        ParamDecl::table("base", BASE, "a moving base (a vessel): the ground frame's position and roll as functions of time (docs/offshore.md)").optional("fixed"),
     ],
     build_planar_arm,
 )
@@ -455,6 +478,13 @@ fn scene(p: &dyn Params) -> Result<ArmScene, BuildError> {
         });
     }
     scene.paper_reactions = p.flag("paper_reactions")?;
+    if let Some(b) = p.table("base")? {
+        scene.base = Some(crate::base::Base {
+            x: b.motion("x").map_err(|e| e.within("base"))?,
+            y: b.motion("y").map_err(|e| e.within("base"))?,
+            roll: b.motion("roll").map_err(|e| e.within("base"))?,
+        });
+    }
     // The spring parameters are read whatever the model, so that `--set` can switch
     // `lumped_model` alone.
     let stiffness = p.optional("lumped_stiffness")?;

@@ -31,11 +31,13 @@ use nalgebra::DVector;
 
 use crate::actuator::LinearActuator;
 use crate::arm::PlanarArm;
+use crate::base::Base;
 use crate::elements::ReactionInputs;
 use crate::elements::{
     ActuatorTransformer, ArmCompliance, ArmDamping, ArmInertia, ArmReactions, LumpedGravity,
     LumpedMassTransformer,
 };
+use crate::elements::{BaseLoads, BaseMotion, BASE_OUTPUTS, OUT_ALPHA, OUT_FIELD, OUT_OMEGA};
 use crate::link::{Link, PointMass};
 use crate::lumped_mass::LumpedMass;
 use crate::quadrature::GaussLegendre;
@@ -82,6 +84,9 @@ pub struct ArmScene {
     /// With lumped masses on springs, also publish the reaction forces of the paper's
     /// variant (masses moving rigidly with their pins) as `rho{k}_paper`.
     pub paper_reactions: bool,
+    /// The moving base ([`base`](crate::base)), if any: adds the members `base` (its motion
+    /// as signals), `inertial` (the loads of its acceleration) and the pedestal's reaction.
+    pub base: Option<Base>,
 }
 
 /// Pad `v` with zeros to length `n`, or complain that it is longer.
@@ -113,6 +118,7 @@ impl ArmScene {
             lumped_masses: Vec::new(),
             lumped_model: LumpedMassModel::Omitted,
             paper_reactions: false,
+            base: None,
         }
     }
 
@@ -162,7 +168,38 @@ impl ArmScene {
         }
         let q = format!("{}.q", member("arm"));
         let mut c = Composite::default();
-        c.element("arm", ArmInertia::new(arm.clone(), q0.clone(), u0.clone())?)
+        let mut inertia = ArmInertia::new(arm.clone(), q0.clone(), u0.clone())?;
+        let base_signal = |k: usize| format!("{}.{}", member("base"), BASE_OUTPUTS[k]);
+        if let Some(base) = &self.base {
+            if arm.has_geometric_stiffening() {
+                return Err(ParamError::shape(
+                    "base",
+                    "a moving base is not combined with geometric_stiffening yet",
+                ));
+            }
+            if !springs.is_empty() {
+                return Err(ParamError::shape(
+                    "base",
+                    "a moving base needs the lumped masses rigid or left out (lumped_model = \"rigid\" or \"none\"): the loads of the base's roll on masses hanging on springs are not modelled",
+                ));
+            }
+            if base.rolls() {
+                let omega0 = base.roll.eval(0.0)[1];
+                inertia =
+                    inertia.on_rolling_base(base_signal(OUT_OMEGA), base_signal(OUT_ALPHA), omega0);
+            }
+            c.element("base", BaseMotion::new(base.clone(), self.gravity))
+                .element(
+                    "inertial",
+                    BaseLoads::new(
+                        arm.clone(),
+                        &q,
+                        [base_signal(OUT_FIELD), base_signal(OUT_FIELD + 1)],
+                    ),
+                )
+                .bond("b_inertial", "j", "inertial");
+        }
+        c.element("arm", inertia)
             .element("j", OneJunction)
             .element("c", ArmCompliance::new(arm.clone(), &q))
             .element("r", ArmDamping::new(damping)?);
@@ -222,6 +259,14 @@ impl ArmScene {
             udot: format!("{arm_name}.udot"),
             forces,
             pin_forces,
+            base: self.base.as_ref().map(|_| {
+                [
+                    base_signal(OUT_OMEGA),
+                    base_signal(OUT_ALPHA),
+                    base_signal(OUT_FIELD),
+                    base_signal(OUT_FIELD + 1),
+                ]
+            }),
         };
         c.element(
             "rho",

@@ -68,6 +68,12 @@ pub trait Params {
     /// A list of nested tables (empty when absent).
     fn tables(&self, key: &str) -> Result<Vec<Box<dyn Params + '_>>, BuildError>;
 
+    /// A prescribed motion of time with exact derivatives (default: a constant via
+    /// [`number`](Self::number); the model loader differentiates expressions of `t`).
+    fn motion(&self, key: &str) -> Result<crate::Motion, BuildError> {
+        self.number(key).map(crate::Motion::Const)
+    }
+
     /// The global name of a composite member: `<instance>_<local>` ([`member_name`]).
     fn member(&self, local: &str) -> String {
         member_name(self.name(), local)
