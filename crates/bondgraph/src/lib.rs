@@ -120,8 +120,8 @@ pub use graph::{BondGraph, Node};
 pub use kind::{BuildError, Composite, KindDecl, ParamDecl, Params};
 pub use linearize::{linearize, BodePoint, Linearization, MAX_BODE_STATES, MAX_LINEARIZE_STATES};
 pub use local_jacobian::{LocalJacobian, LocalShape};
+pub use motion::{Motion, MotionLaw};
 pub use modes::{modes, modes_of, stiffness_ratio, Mode, ModesError, MAX_MODES_STATES};
-pub use motion::Motion;
 /// The dense matrix type of [`StateEquations::jacobian`].
 pub use nalgebra::DMatrix;
 pub use partials_check::check_partials;

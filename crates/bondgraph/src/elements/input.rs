@@ -36,15 +36,18 @@ pub enum Interp {
     Linear,
     /// Zero-order hold: each sample's value until the next sample time.
     Hold,
+    /// A C² cubic spline through the samples, not-a-knot ends (see [`Series::jet`]).
+    Spline,
 }
 
 impl Interp {
-    /// Parse `linear` or `hold` (also `zoh`, `zero-order-hold`).
+    /// Parse `linear`, `hold` (also `zoh`, `zero-order-hold`) or `spline`.
     #[must_use]
     pub fn parse(s: &str) -> Option<Self> {
         match s.to_ascii_lowercase().as_str() {
             "linear" => Some(Self::Linear),
             "hold" | "zoh" | "zero-order-hold" => Some(Self::Hold),
+            "spline" => Some(Self::Spline),
             _ => None,
         }
     }
@@ -54,6 +57,7 @@ impl Interp {
         match self {
             Self::Linear => "linear",
             Self::Hold => "hold",
+            Self::Spline => "spline",
         }
     }
 }
@@ -64,6 +68,8 @@ pub struct Series {
     times: Vec<f64>,
     values: Vec<f64>,
     interp: Interp,
+    /// The spline's second derivatives at the samples ([`Interp::Spline`]; else empty).
+    curvature: Vec<f64>,
 }
 
 impl Series {
@@ -112,10 +118,16 @@ impl Series {
                 ));
             }
         }
+        let curvature = if interp == Interp::Spline {
+            not_a_knot(&times, &values)
+        } else {
+            Vec::new()
+        };
         Ok(Self {
             times,
             values,
             interp,
+            curvature,
         })
     }
     /// A constant as a one-sample series.
@@ -125,6 +137,7 @@ impl Series {
             times: vec![0.0],
             values: vec![value],
             interp: Interp::Hold,
+            curvature: Vec::new(),
         }
     }
     /// The sample times: the series' breakpoints (its corners).
@@ -168,7 +181,50 @@ impl Series {
                 let (v0, v1) = (self.values[j - 1], self.values[j]);
                 v0 + (v1 - v0) * ((t - t0) / (t1 - t0))
             }
+            Interp::Spline => self.jet_on_piece(j, t)[0],
         }
+    }
+    /// [value, d/dt, d²/dt²] of piece `j` at `t`, exact for the piece's own law: a constant
+    /// outside the samples and for [`Interp::Hold`], a line for [`Interp::Linear`], and for
+    /// [`Interp::Spline`] the cubic with second derivatives Mᵢ, Mᵢ₊₁ at its ends
+    /// (h = tᵢ₊₁ − tᵢ, a = tᵢ₊₁ − t, b = t − tᵢ):
+    ///
+    /// s = Mᵢa³/6h + Mᵢ₊₁b³/6h + (yᵢ/h − Mᵢh/6)·a + (yᵢ₊₁/h − Mᵢ₊₁h/6)·b.
+    #[must_use]
+    pub fn jet_on_piece(&self, j: usize, t: f64) -> [f64; 3] {
+        let n = self.times.len();
+        if j == 0 {
+            return [self.values[0], 0.0, 0.0];
+        }
+        if j >= n {
+            return [self.values[n - 1], 0.0, 0.0];
+        }
+        let (t0, t1) = (self.times[j - 1], self.times[j]);
+        let (y0, y1) = (self.values[j - 1], self.values[j]);
+        let h = t1 - t0;
+        match self.interp {
+            Interp::Hold => [y0, 0.0, 0.0],
+            Interp::Linear => {
+                let slope = (y1 - y0) / h;
+                [y0 + (y1 - y0) * ((t - t0) / h), slope, 0.0]
+            }
+            Interp::Spline => {
+                let (m0, m1) = (self.curvature[j - 1], self.curvature[j]);
+                let (a, b) = (t1 - t, t - t0);
+                let value = (m0 * a * a * a + m1 * b * b * b) / (6.0 * h)
+                    + (y0 / h - m0 * h / 6.0) * a
+                    + (y1 / h - m1 * h / 6.0) * b;
+                let rate = (-m0 * a * a + m1 * b * b) / (2.0 * h) - (y0 / h - m0 * h / 6.0)
+                    + (y1 / h - m1 * h / 6.0);
+                let accel = (m0 * a + m1 * b) / h;
+                [value, rate, accel]
+            }
+        }
+    }
+    /// [value, d/dt, d²/dt²] at `t` (see [`jet_on_piece`](Self::jet_on_piece)).
+    #[must_use]
+    pub fn jet(&self, t: f64) -> [f64; 3] {
+        self.jet_on_piece(self.piece(t), t)
     }
     /// The value at `t`.
     #[must_use]
@@ -185,6 +241,60 @@ impl Series {
 /// The time tolerance of the simulation near `t` (two times closer than this are one).
 fn time_tolerance(t: f64) -> f64 {
     1e-10 * (1.0 + t.abs())
+}
+
+/// The second derivatives Mᵢ of the not-a-knot cubic spline through (tᵢ, yᵢ): the third
+/// derivative is continuous at the second and the last-but-one samples, so the first two
+/// pieces are one cubic and so are the last two (a cubic is reproduced exactly). Interior
+/// rows: hᵢ₋₁Mᵢ₋₁ + 2(hᵢ₋₁ + hᵢ)Mᵢ + hᵢMᵢ₊₁ = 6(Δᵢ − Δᵢ₋₁), Δᵢ = (yᵢ₊₁ − yᵢ)/hᵢ; the end
+/// conditions, e.g. h₁M₀ − (h₀ + h₁)M₁ + h₀M₂ = 0, are eliminated into the first and last
+/// rows, leaving a tridiagonal system (Thomas algorithm). Three samples give their parabola,
+/// two their line, one a constant.
+fn not_a_knot(t: &[f64], y: &[f64]) -> Vec<f64> {
+    let n = t.len();
+    if n < 3 {
+        return vec![0.0; n];
+    }
+    let h: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+    let d: Vec<f64> = (0..n - 1).map(|i| (y[i + 1] - y[i]) / h[i]).collect();
+    if n == 3 {
+        let m = 2.0 * (d[1] - d[0]) / (h[0] + h[1]);
+        return vec![m; 3];
+    }
+    // unknowns M₁ … M_{n−2}: sub, diag, sup, rhs
+    let k = n - 2;
+    let mut sub = vec![0.0; k];
+    let mut diag = vec![0.0; k];
+    let mut sup = vec![0.0; k];
+    let mut rhs = vec![0.0; k];
+    for r in 0..k {
+        let i = r + 1;
+        sub[r] = h[i - 1];
+        diag[r] = 2.0 * (h[i - 1] + h[i]);
+        sup[r] = h[i];
+        rhs[r] = 6.0 * (d[i] - d[i - 1]);
+    }
+    // M₀ = ((h₀ + h₁)M₁ − h₀M₂)/h₁ into row 1
+    diag[0] += h[0] * (h[0] + h[1]) / h[1];
+    sup[0] -= h[0] * h[0] / h[1];
+    // M_{n−1} = ((h_{n−2} + h_{n−3})M_{n−2} − h_{n−2}M_{n−3})/h_{n−3} into the last row
+    let (a, b) = (h[n - 2], h[n - 3]);
+    diag[k - 1] += a * (a + b) / b;
+    sub[k - 1] -= a * a / b;
+    // Thomas
+    for r in 1..k {
+        let w = sub[r] / diag[r - 1];
+        diag[r] -= w * sup[r - 1];
+        rhs[r] -= w * rhs[r - 1];
+    }
+    let mut m = vec![0.0; n];
+    m[k] = rhs[k - 1] / diag[k - 1];
+    for r in (0..k - 1).rev() {
+        m[r + 1] = (rhs[r] - sup[r] * m[r + 2]) / diag[r];
+    }
+    m[0] = ((h[0] + h[1]) * m[1] - h[0] * m[2]) / h[1];
+    m[n - 1] = ((a + b) * m[n - 2] - a * m[n - 3]) / b;
+    m
 }
 
 /// What an input is, for listings (`bg-sim check`) and for programs driving the model.
@@ -205,6 +315,8 @@ pub struct InputSpec {
 enum Source {
     Value(f64),
     Series(Series),
+    /// A function of time with exact derivatives (a sea state).
+    Motion(crate::Motion),
 }
 
 /// An external input (see the module documentation).
@@ -248,12 +360,33 @@ impl Input {
         self.locked.set(None);
         self.hint.set(0);
     }
+    /// Follow the function of time `motion` from now on (a sea state): no breakpoints.
+    pub fn set_motion(&self, motion: crate::Motion) {
+        *self.source.borrow_mut() = Source::Motion(motion);
+        self.locked.set(None);
+    }
     /// The series followed, if any.
     #[must_use]
     pub fn series(&self) -> Option<Series> {
         match &*self.source.borrow() {
             Source::Series(s) => Some(s.clone()),
-            Source::Value(_) => None,
+            Source::Value(_) | Source::Motion(_) => None,
+        }
+    }
+    /// [value, d/dt, d²/dt²] at `t`: a value stands still; a series gives its piece's
+    /// derivatives (exact inside a segment between breakpoints); a motion its own.
+    #[must_use]
+    pub fn jet(&self, t: f64) -> [f64; 3] {
+        match &*self.source.borrow() {
+            Source::Value(v) => [*v, 0.0, 0.0],
+            Source::Series(s) => {
+                let j = match self.locked.get() {
+                    Some(j) => j,
+                    None => self.lookup(s, t),
+                };
+                s.jet_on_piece(j, t)
+            }
+            Source::Motion(m) => m.eval(t),
         }
     }
     /// The value at `t`.
@@ -268,6 +401,7 @@ impl Input {
                 };
                 s.on_piece(j, t)
             }
+            Source::Motion(m) => m.eval(t)[0],
         }
     }
     /// The piece of `s` at `t`, starting from the last one found.
@@ -294,7 +428,7 @@ impl Input {
     pub fn lock_at(&self, t: f64) {
         let j = match &*self.source.borrow() {
             Source::Series(s) => Some(s.piece(t)),
-            Source::Value(_) => None,
+            Source::Value(_) | Source::Motion(_) => None,
         };
         self.locked.set(j);
     }
@@ -307,7 +441,7 @@ impl Input {
     pub fn next_breakpoint(&self, t: f64) -> Option<f64> {
         match &*self.source.borrow() {
             Source::Series(s) => s.next_breakpoint(t),
-            Source::Value(_) => None,
+            Source::Value(_) | Source::Motion(_) => None,
         }
     }
 }
@@ -413,5 +547,65 @@ mod tests {
             let t = (f64::from(k) * 0.37).sin() * 3.0 + 2.0 + f64::from(k % 7) * 0.013;
             assert_eq!(u.value(t), s.at(t), "t = {t}");
         }
+    }
+
+    #[test]
+    fn a_not_a_knot_spline_reproduces_a_cubic_with_its_derivatives() {
+        let f = |t: f64| [
+            2.0 - t + 0.5 * t * t - 0.3 * t * t * t,
+            -1.0 + t - 0.9 * t * t,
+            1.0 - 1.8 * t,
+        ];
+        let times = vec![0.0, 0.4, 1.1, 1.5, 2.6, 3.0, 4.2];
+        let values = times.iter().map(|&t| f(t)[0]).collect();
+        let s = Series::new(times, values, Interp::Spline).unwrap();
+        for k in 0..84 {
+            let t = f64::from(k) * 0.05;
+            let (got, want) = (s.jet(t), f(t));
+            for d in 0..3 {
+                assert!((got[d] - want[d]).abs() < 1e-11, "t {t}, derivative {d}: {got:?} vs {want:?}");
+            }
+        }
+        // three samples: their parabola; two: their line
+        let p = Series::new(vec![0.0, 1.0, 3.0], vec![1.0, 2.0, 10.0], Interp::Spline).unwrap();
+        // y = 1 + 0·t + t²... through (0,1), (1,2), (3,10): y = 1 + t²·1 + 0·t
+        assert!((p.jet(2.0)[0] - 5.0).abs() < 1e-12 && (p.jet(2.0)[2] - 2.0).abs() < 1e-12);
+        let l = Series::new(vec![0.0, 2.0], vec![1.0, 5.0], Interp::Spline).unwrap();
+        assert_eq!(l.jet(0.5), [2.0, 2.0, 0.0]);
+    }
+
+    #[test]
+    fn spline_derivatives_match_finite_differences_and_the_spline_is_c2() {
+        let times: Vec<f64> = (0..30).map(|k| f64::from(k) * 0.3 + 0.01 * f64::from(k % 4)).collect();
+        let values: Vec<f64> = times.iter().map(|t| (1.3 * t).sin() + 0.2 * t).collect();
+        let s = Series::new(times.clone(), values, Interp::Spline).unwrap();
+        let h = 1e-5;
+        for k in 1..200 {
+            let t = f64::from(k) * 0.043;
+            let j = s.piece(t);
+            let [v, d1, d2] = s.jet_on_piece(j, t);
+            let (p, m) = (s.jet_on_piece(j, t + h), s.jet_on_piece(j, t - h));
+            assert!((d1 - (p[0] - m[0]) / (2.0 * h)).abs() < 1e-7, "t {t}");
+            assert!((d2 - (p[1] - m[1]) / (2.0 * h)).abs() < 1e-7, "t {t}");
+            assert!((v - s.at(t)).abs() < 1e-15);
+        }
+        // continuity of value, slope and curvature at the interior samples
+        for (i, &tk) in times.iter().enumerate().skip(1).take(times.len() - 2) {
+            let (left, right) = (s.jet_on_piece(i, tk), s.jet_on_piece(i + 1, tk));
+            for d in 0..3 {
+                assert!((left[d] - right[d]).abs() < 1e-9, "sample {i}, derivative {d}");
+            }
+        }
+    }
+
+    #[test]
+    fn an_input_follows_a_motion_with_its_derivatives_and_no_breakpoints() {
+        let u = Input::new(spec()).unwrap();
+        u.set_motion(crate::Motion::law(|t| [t.sin(), t.cos(), -t.sin()]));
+        assert_eq!(u.value(0.5), 0.5f64.sin());
+        assert_eq!(u.jet(0.5), [0.5f64.sin(), 0.5f64.cos(), -(0.5f64.sin())]);
+        assert_eq!(u.next_breakpoint(0.0), None);
+        u.set(3.0);
+        assert_eq!(u.jet(1.0), [3.0, 0.0, 0.0]);
     }
 }

@@ -63,16 +63,16 @@ pub trait Params {
     fn vector(&self, key: &str) -> Result<Vec<f64>, BuildError>;
     /// A matrix of expressions.
     fn matrix(&self, key: &str) -> Result<MatrixParam, BuildError>;
+    /// A prescribed motion: x(t) with exact ẋ, ẍ ([`crate::Motion`]), from an expression of
+    /// time (declared as a modulated parameter). The default reads a constant; the model
+    /// loader compiles expressions of `t`, parameters and inputs with known derivatives.
+    fn motion(&self, key: &str) -> Result<crate::Motion, BuildError> {
+        self.number(key).map(crate::Motion::Const)
+    }
     /// A nested table, `None` when absent.
     fn table(&self, key: &str) -> Result<Option<Box<dyn Params + '_>>, BuildError>;
     /// A list of nested tables (empty when absent).
     fn tables(&self, key: &str) -> Result<Vec<Box<dyn Params + '_>>, BuildError>;
-
-    /// A prescribed motion of time with exact derivatives (default: a constant via
-    /// [`number`](Self::number); the model loader differentiates expressions of `t`).
-    fn motion(&self, key: &str) -> Result<crate::Motion, BuildError> {
-        self.number(key).map(crate::Motion::Const)
-    }
 
     /// The global name of a composite member: `<instance>_<local>` ([`member_name`]).
     fn member(&self, local: &str) -> String {

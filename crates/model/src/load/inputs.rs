@@ -186,7 +186,7 @@ fn entry(
         None => Interp::Linear,
         Some(s) => Interp::parse(&s).ok_or_else(|| {
             err(format!("`interp` of input `{name}` is `{}`", clip(&s)))
-                .hint("`interp` is \"linear\" or \"hold\"")
+                .hint("`interp` is \"linear\", \"hold\" or \"spline\"")
         })?,
     };
     let extrapolate = match text("extrapolate")? {
