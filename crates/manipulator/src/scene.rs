@@ -38,6 +38,7 @@ use crate::elements::{
     LumpedMassTransformer,
 };
 use crate::elements::{BaseLoads, BaseMotion, BASE_OUTPUTS, OUT_ALPHA, OUT_FIELD, OUT_OMEGA};
+use crate::elements::{WirePayload, WireSpec, PAYLOAD_OUTPUTS};
 use crate::link::{Link, PointMass};
 use crate::lumped_mass::LumpedMass;
 use crate::quadrature::GaussLegendre;
@@ -87,6 +88,10 @@ pub struct ArmScene {
     /// The moving base ([`base`](crate::base)), if any: adds the members `base` (its motion
     /// as signals), `inertial` (the loads of its acceleration) and the pedestal's reaction.
     pub base: Option<Base>,
+    /// A payload on an elastic wire from the end of the last chord
+    /// ([`WirePayload`](crate::elements::WirePayload)): the member `payload`, with the
+    /// exposed port `wire` when a winch pays it out.
+    pub payload: Option<WireSpec>,
 }
 
 /// Pad `v` with zeros to length `n`, or complain that it is longer.
@@ -119,6 +124,7 @@ impl ArmScene {
             lumped_model: LumpedMassModel::Omitted,
             paper_reactions: false,
             base: None,
+            payload: None,
         }
     }
 
@@ -252,6 +258,20 @@ impl ArmScene {
                 .bond("b_masses", "masses_j", "masses");
             pin_forces = Some(format!("{}.2.e", member("lump")));
         }
+        let mut tip_load = None;
+        if let Some(spec) = &self.payload {
+            let base = self.base.clone().unwrap_or_else(Base::still);
+            c.element(
+                "payload",
+                WirePayload::new(arm.clone(), spec.clone(), base, self.gravity, &q, &q0)?,
+            )
+            .bond("b_payload", "j", "payload.1");
+            if spec.winch {
+                c.port("wire", "payload.wire");
+            }
+            let out = |k: usize| format!("{}.{}", member("payload"), PAYLOAD_OUTPUTS[k]);
+            tip_load = Some([out(7), out(8)]);
+        }
         let arm_name = member("arm");
         let inputs = ReactionInputs {
             q: q.clone(),
@@ -267,6 +287,7 @@ impl ArmScene {
                     base_signal(OUT_FIELD + 1),
                 ]
             }),
+            tip_load,
         };
         c.element(
             "rho",

@@ -11,6 +11,7 @@
 //! | `manipulator.lumped_gravity` | [`LumpedGravity`] | `1`: 2m | e = −g [0 m₁ 0 m₂ …] (eq. 76) |
 //! | `manipulator.reactions` | [`ArmReactions`] | — | publishes ρ (eqs. 84–98); on a moving base also the pedestal's reaction |
 //! | `manipulator.base` | [`BaseMotion`] | — | publishes the base's motion and apparent gravity ([`base`](crate::base)) |
+//! | `manipulator.wire_payload` | [`WirePayload`] | `1`: n, `wire`: 1 | a point mass on an elastic wire from the tip, slack-able, optional landing |
 //! | `manipulator.base_loads` | [`BaseLoads`] | `1`: n | e = −G(q; f − f₀), the loads of the base's acceleration |
 //!
 //! The MTFs follow the core's matrix-MTF convention: draw port 1 *from the MTF into* the
@@ -30,6 +31,7 @@ mod lumped_masses;
 mod mtf_law;
 mod r_field;
 mod reaction_block;
+mod wire_payload;
 
 pub use actuator_mtf::ActuatorTransformer;
 pub(crate) use at_last_q::same_bits;
@@ -42,3 +44,4 @@ pub use lumped_mass_mtf::LumpedMassTransformer;
 pub use lumped_masses::lumped_masses;
 pub use r_field::ArmDamping;
 pub use reaction_block::{ArmReactions, ReactionInputs};
+pub use wire_payload::{Landing, WirePayload, WireSpec, PAYLOAD_OUTPUTS};

@@ -41,6 +41,9 @@ pub struct ReactionInputs {
     /// reaction `F_ped_x`, `F_ped_y` (N, base axes) and `M_ped` (N·m, about joint 1,
     /// counter-clockwise): the load of the arm on the vessel.
     pub base: Option<[String; 4]>,
+    /// A force on the end of the last chord (base axes, a 2-signal pair: the wire's pull,
+    /// `payload.Fx`, `payload.Fy`), if any.
+    pub tip_load: Option<[String; 2]>,
 }
 
 /// The reaction-force block of a [`PlanarArm`].
@@ -51,6 +54,8 @@ pub struct ArmReactions {
     /// Per actuator, its pins (a, b) resolved on the arm.
     acts: Vec<(PinPoint, PinPoint)>,
     springs: Vec<(Station, f64)>,
+    /// The end of the last chord (where a tip load acts).
+    tip: Station,
     paper: bool,
     ws: RefCell<Workspace>,
 }
@@ -106,7 +111,10 @@ impl ArmReactions {
             })
             .collect::<Result<_, ParamError>>()?;
         let (n, n_rho) = (arm.n(), 2 * arm.n_links());
+        let last = arm.n_links() - 1;
+        let tip = arm.station(last, arm.links()[last].length())?;
         Ok(Self {
+            tip,
             ws: RefCell::new(Workspace {
                 frames: arm.frames(),
                 q: vec![0.0; n],
@@ -172,6 +180,7 @@ impl Element for ArmReactions {
             s.push(v(p, 2 * self.springs.len()));
         }
         s.extend(self.inputs.base.iter().flatten().map(|b| v(b, 1)));
+        s.extend(self.inputs.tip_load.iter().flatten().map(|b| v(b, 1)));
         s
     }
     fn signal_outputs(&self) -> Vec<SignalSpec> {
@@ -229,6 +238,13 @@ impl Element for ArmReactions {
                         .filter_map(|(s, f)| s.map(|s| (s, f)))
                 })
         };
+        let first_tip = first_base + 4 * usize::from(self.inputs.base.is_some());
+        let tip_load = self.inputs.tip_load.as_ref().map(|_| {
+            (
+                &self.tip,
+                Vector2::new(io.u(first_tip), io.u(first_tip + 1)),
+            )
+        });
         let pin_forces = self
             .inputs
             .pin_forces
@@ -240,24 +256,45 @@ impl Element for ArmReactions {
             .enumerate()
             .map(|(k, (s, _))| (s, Vector2::new(pin_forces[2 * k], pin_forces[2 * k + 1])));
         let weight = field.map_or(Vector2::new(0.0, self.arm.gravity()), |f| -f);
-        kin.reactions_in_field_into(u, udot, act_loads().chain(spring_loads), &[], weight, rho);
+        kin.reactions_in_field_into(
+            u,
+            udot,
+            act_loads().chain(spring_loads).chain(tip_load),
+            &[],
+            weight,
+            rho,
+        );
         if self.paper {
             if self.springs.is_empty() {
                 rho_paper.copy_from_slice(rho);
             } else {
-                kin.reactions_in_field_into(u, udot, act_loads(), &self.springs, weight, rho_paper);
+                kin.reactions_in_field_into(
+                    u,
+                    udot,
+                    act_loads().chain(tip_load),
+                    &self.springs,
+                    weight,
+                    rho_paper,
+                );
             }
         }
         let pedestal = field.map(|f| {
             // the force on the whole arm from the vessel: Σ m (a − f), frame 0
             kin.reactions_in_field_into(u, udot, std::iter::empty(), &[], weight, all);
-            let force = kin.pose().to_base(0, &Vector2::new(all[0], all[1]));
+            let mut force = kin.pose().to_base(0, &Vector2::new(all[0], all[1]));
+            // less the wire's pull: the rest comes from the vessel
+            g.fill(0.0);
+            if let Some((s, f)) = tip_load {
+                force -= f;
+                kin.pose().add_point_force(s, &f, g);
+            }
+            let wire_moment = g[0];
             // the moment about joint 1: Q₁ = (M u̇_a + Ṁ u_a − E(u_a))₁ − G(q; f)₁
             kin.mass_matrix_into(m);
             kin.kinetic_terms_into(u, e, Some(mdot_u));
             kin.field_forces_into(&f, g);
             let m_u: f64 = (0..u.len()).map(|k| m[(0, k)] * udot[k]).sum();
-            let moment = m_u + mdot_u[0] - e[0] - g[0];
+            let moment = m_u + mdot_u[0] - e[0] - g[0] - wire_moment;
             [-force.x, -force.y, -moment]
         });
         drop(kin);
