@@ -25,6 +25,8 @@
 //! paper_reactions = false             # also publish rho{k}_paper (springs only)
 //! geometric_stiffening = false        # keep the axial shortening of the bent links
 //! base = { y = "0.5*sin(0.7*t)", roll = "0.02*sin(0.5*t)" }   # a moving base (default: fixed)
+//! payload = { type = "wire", mass = "m3", EA = 5e7, length = 6, winch = true,
+//!             landing = { height = "-20 + 0.8*sin(0.6*t)", k = 1e8, lambda = 2e6 } }
 //! ```
 //!
 //! Links are numbered from 1 as in the paper. A link table has `type` = `"beam"` (length, E,
@@ -176,6 +178,27 @@ const BASE: &[ParamDecl] = &[
     .default(0.0),
 ];
 
+const LANDING: &[ParamDecl] = &[
+    ParamDecl::modulated("height", "m", "height of the landing surface (inertial, up), an expression of t").default(0.0),
+    ParamDecl::number("k", "", "contact stiffness k of F = k δⁿ + λ δⁿ δ̇ (N/mⁿ)").positive(),
+    ParamDecl::number("n", "", "contact exponent n (1.5: Hertz)").positive().default(1.5),
+    ParamDecl::number("lambda", "", "Hunt–Crossley damping λ (N·s/mⁿ⁺¹); λ = 3k(1 − e)/(2 v) for a restitution e at impact speed v").non_negative().default(0.0),
+    ParamDecl::number("mu", "", "Coulomb friction coefficient").non_negative().default(0.0),
+    ParamDecl::number("slip_speed", "m/s", "sliding speed over which friction builds up (tanh)").positive().default(0.01),
+];
+
+const PAYLOAD: &[ParamDecl] = &[
+    ParamDecl::choice("type", &["wire"], "wire", "a point mass on an elastic wire from the end of the last link"),
+    ParamDecl::number("mass", "kg", "payload mass").positive(),
+    ParamDecl::number("EA", "N", "axial stiffness of the wire; k = EA/L").positive(),
+    ParamDecl::number("damping", "s", "Kelvin–Voigt time constant of the wire: c = damping·EA/L").non_negative().default(0.0),
+    ParamDecl::number("length", "m", "paid-out length (at the start, with a winch)").positive(),
+    ParamDecl::flag("winch", false, "a winch pays the wire out through the exposed port `wire` (tension, pay-out speed)"),
+    ParamDecl::number("slack_band", "m", "stretch over which the tension's slack/taut transition is smoothed (C¹)").positive().default(1e-6),
+    ParamDecl::flag("start_stretched", true, "start hanging at rest with the static stretch m g L/EA"),
+    ParamDecl::table("landing", LANDING, "a landing surface under the payload (Hunt–Crossley contact)").optional("none"),
+];
+
 /// Kind `manipulator.planar_arm`.
 pub const PLANAR_ARM: KindDecl = KindDecl::composite(
     "manipulator.planar_arm",
@@ -198,6 +221,7 @@ pub const PLANAR_ARM: KindDecl = KindDecl::composite(
         ParamDecl::number("lumped_damping", "N·s/m", "spring damping of lumped masses (with \"springs\")").non_negative().default(0.0),
         ParamDecl::flag("paper_reactions", false, "also publish rho{k}_paper (springs only)"),
         ParamDecl::flag("geometric_stiffening", false, "keep the axial shortening of bent links (axial-force stiffening; docs/manipulator.md)"),
+        ParamDecl::table("payload", PAYLOAD, "a payload on an elastic wire of varying length from the end of the last link (docs/offshore.md)").optional("none"),
         ParamDecl::table("base", BASE, "a moving base (a vessel): the ground frame's position and roll as functions of time (docs/offshore.md)").optional("fixed"),
     ],
     build_planar_arm,
@@ -478,6 +502,33 @@ fn scene(p: &dyn Params) -> Result<ArmScene, BuildError> {
         });
     }
     scene.paper_reactions = p.flag("paper_reactions")?;
+    if let Some(t) = p.table("payload")? {
+        let at = |e: BuildError| e.within("payload");
+        let landing = match t.table("landing").map_err(at)? {
+            None => None,
+            Some(l) => {
+                let at = |e: BuildError| e.within("payload.landing");
+                Some(crate::elements::Landing {
+                    height: l.motion("height").map_err(at)?,
+                    stiffness: l.number("k").map_err(at)?,
+                    exponent: l.number("n").map_err(at)?,
+                    damping: l.number("lambda").map_err(at)?,
+                    friction: l.number("mu").map_err(at)?,
+                    slip_speed: l.number("slip_speed").map_err(at)?,
+                })
+            }
+        };
+        scene.payload = Some(crate::elements::WireSpec {
+            mass: t.number("mass").map_err(at)?,
+            ea: t.number("EA").map_err(at)?,
+            damping: t.number("damping").map_err(at)?,
+            length: t.number("length").map_err(at)?,
+            winch: t.flag("winch").map_err(at)?,
+            slack_band: t.number("slack_band").map_err(at)?,
+            start_stretched: t.flag("start_stretched").map_err(at)?,
+            landing,
+        });
+    }
     if let Some(b) = p.table("base")? {
         scene.base = Some(crate::base::Base {
             x: b.motion("x").map_err(|e| e.within("base"))?,
