@@ -26,5 +26,6 @@ pub fn registry() -> Registry {
     let mut r = Registry::with_core();
     r.add(bg_hydraulics::KINDS);
     r.add(bg_manipulator::KINDS);
+    r.add(bg_mechanical::KINDS);
     r
 }

@@ -1,9 +1,10 @@
 //! The core's element kinds, each declared beside its law in `elements/`: the list a model
-//! loader registers (`Se Sf R C I TF MTF GY MGY 0 1 lag p_control signal`).
+//! loader registers (`Se Sf R C I TF MTF GY MGY 0 1 lag p_control signal Sf_position
+//! integrator`).
 
 use crate::elements::{
-    capacitor, gyrator, inertia, junction, lag, matrix_transformer, p_controller, resistor,
-    signal_function, sources, transformer,
+    capacitor, gyrator, inertia, integrator, junction, lag, matrix_transformer, p_controller,
+    position_source, resistor, signal_function, sources, transformer,
 };
 use crate::KindDecl;
 
@@ -23,4 +24,6 @@ pub const KINDS: &[KindDecl] = &[
     lag::KIND,
     p_controller::KIND,
     signal_function::KIND,
+    position_source::KIND,
+    integrator::KIND,
 ];

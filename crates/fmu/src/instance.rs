@@ -46,6 +46,7 @@ pub const MANIFEST: &str = "bg-sim-fmu.toml";
 pub fn registry() -> Registry {
     let mut r = Registry::with_core();
     r.add(bg_hydraulics::KINDS);
+    r.add(bg_mechanical::KINDS);
     r.add(bg_manipulator::KINDS);
     r
 }

@@ -9,6 +9,7 @@ use std::sync::Arc;
 
 use crate::tables::Tables;
 
+mod jet;
 mod parser;
 use parser::Parser;
 

@@ -18,6 +18,7 @@ mod model;
 mod outputs;
 mod parse;
 mod resolve;
+mod sea;
 mod settings;
 mod source;
 mod stepping;

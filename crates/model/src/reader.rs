@@ -48,6 +48,8 @@ pub struct ElementSpec<'a> {
     pub(crate) inputs: &'a [String],
     /// The model's `[tables]`, callable in expressions.
     pub(crate) tables: Arc<Tables>,
+    /// The `[inputs]` whose time derivatives are known, for [`Params::motion`].
+    pub(crate) motions: Arc<IndexMap<String, bondgraph::Motion>>,
 }
 
 fn kind_of(e: &BuildError) -> ErrorKind {
@@ -85,6 +87,7 @@ impl<'a> ElementSpec<'a> {
             used_constants,
             inputs: &[],
             tables: Arc::new(Tables::default()),
+            motions: Arc::default(),
         }
     }
 
@@ -414,6 +417,7 @@ impl<'a> ElementSpec<'a> {
             used_constants: self.used_constants,
             inputs: self.inputs,
             tables: Arc::clone(&self.tables),
+            motions: Arc::clone(&self.motions),
         };
         spec.validate()?;
         Ok(Box::new(spec))

@@ -15,16 +15,20 @@
 //! | `lag` | [`Lag`] | τ·dy/dt = u − y |
 //! | `p_control` | [`PController`] | y = clamp(K·(r − u), lo, hi) |
 //! | `signal` | [`SignalFunction`] | y = g(t, signals) |
+//! | `Sf_position` | [`PositionSource`] | f_in = −ẋ(t) of a prescribed position x(t) |
+//! | `integrator` | [`Integrator`] | dy/dt = u, limits without windup, reset |
 //! | (`[inputs]`) | [`Input`] | y = u(t), set from outside |
 
 pub(crate) mod capacitor;
 pub(crate) mod gyrator;
 pub(crate) mod inertia;
 pub(crate) mod input;
+pub(crate) mod integrator;
 pub(crate) mod junction;
 pub(crate) mod lag;
 pub(crate) mod matrix_transformer;
 pub(crate) mod p_controller;
+pub(crate) mod position_source;
 pub(crate) mod resistor;
 pub(crate) mod signal_function;
 pub(crate) mod sources;
@@ -34,12 +38,14 @@ pub use capacitor::Capacitor;
 pub use gyrator::Gyrator;
 pub use inertia::Inertia;
 pub use input::{Input, InputSpec, Interp, Series};
+pub use integrator::Integrator;
 pub use junction::{OneJunction, ZeroJunction};
 pub use lag::Lag;
 pub use matrix_transformer::{
     apply_effort, apply_flow, effort_partials, flow_partials, MatrixTransformer, ModulusLaw,
 };
 pub use p_controller::PController;
+pub use position_source::PositionSource;
 pub use resistor::Resistor;
 pub use signal_function::SignalFunction;
 pub use sources::{EffortSource, FlowSource};

@@ -98,6 +98,7 @@ impl Source {
         );
         spec.inputs = &input_names;
         spec.tables = std::sync::Arc::clone(&self.tables);
+        spec.motions = std::sync::Arc::new(super::inputs::motions(&self.inputs));
         spec.validate().map_err(|e| spec.locate(e))?;
         let built = match info.build {
             bondgraph::kind::Build::Element(f) => Built::One(f(&spec).map_err(|e| spec.locate(e))?),

@@ -62,6 +62,9 @@ pub(crate) struct InputDef {
     pub(crate) spec: InputSpec,
     pub(crate) span: Range<usize>,
     pub(crate) data: Option<DataRef>,
+    /// The input's motion when its time derivatives are known: a sea state, or data with
+    /// `interp = "spline"` (`super::sea`).
+    pub(crate) motion: Option<bondgraph::Motion>,
 }
 
 const KEYS: &[&str] = &[
@@ -72,6 +75,7 @@ const KEYS: &[&str] = &[
     "column",
     "interp",
     "extrapolate",
+    "sea",
 ];
 
 /// Read the `[inputs]` entries; each problem goes to `problems`.
@@ -150,6 +154,7 @@ fn entry(
                 spec,
                 span,
                 data: None,
+                motion: None,
             });
         }
         _ => {
@@ -211,7 +216,32 @@ fn entry(
             )
         }
     };
-    Ok(InputDef { spec, span, data })
+    let motion = motion_of(name, table, &data, source, parameters, &err)?;
+    Ok(InputDef {
+        spec,
+        span,
+        data,
+        motion,
+    })
+}
+
+/// The motion of an input with known derivatives: its `sea` table, or its data when
+/// interpolated by a spline (`super::sea`).
+fn motion_of(
+    name: &str,
+    table: &toml::map::Map<String, toml::Value>,
+    data: &Option<DataRef>,
+    source: &Source,
+    parameters: &IndexMap<String, f64>,
+    err: &dyn Fn(String) -> ModelError,
+) -> Result<Option<bondgraph::Motion>, ModelError> {
+    match (table.get("sea"), data) {
+        (Some(_), Some(_)) => Err(err(format!("input `{name}` has both `sea` and `file`"))
+            .hint("an input follows either a sea state or data: drop one")),
+        (Some(v), None) => super::sea::motion(name, v, source, parameters, err).map(Some),
+        (None, Some(r)) => Ok(super::sea::spline(source, &r.file, &r.column, r.interp)),
+        (None, None) => Ok(None),
+    }
 }
 
 /// The input elements, to add to the graph before the entries.
@@ -226,8 +256,24 @@ pub(super) fn elements(
                     .err(ErrorKind::Input, Some(&d.span), e.to_string())
                     .element(&d.spec.name)
             });
+            let el = el.map(|el| with_motion(el, d));
             (d.spec.name.clone(), el)
         })
+        .collect()
+}
+
+/// A sea input follows its motion (a data input gets its series in [`apply_files`]).
+fn with_motion(el: Input, d: &InputDef) -> Input {
+    if let (Some(m), None) = (&d.motion, &d.data) {
+        el.set_motion(m.clone());
+    }
+    el
+}
+
+/// The motions of the inputs whose time derivatives are known, by name.
+pub(super) fn motions(defs: &[InputDef]) -> IndexMap<String, bondgraph::Motion> {
+    defs.iter()
+        .filter_map(|d| Some((d.spec.name.clone(), d.motion.clone()?)))
         .collect()
 }
 

@@ -60,6 +60,31 @@ impl Params for ElementSpec<'_> {
             move |_, u, grad| g.eval_grad(u, grad),
         ))
     }
+    fn motion(&self, key: &str) -> Result<bondgraph::Motion, BuildError> {
+        let d = self.decl(key)?;
+        let Some(v) = self.raw(key) else {
+            return self
+                .default_number(d)?
+                .map(bondgraph::Motion::Const)
+                .ok_or_else(|| self.missing(d));
+        };
+        let e = self.expr(d, v)?;
+        for n in e.names() {
+            if self.constants.contains_key(&n) {
+                self.used_constants.borrow_mut().insert(n);
+            }
+        }
+        let m = e
+            .motion(&|n| self.constants.get(n).copied(), &|n| self.motions.get(n).cloned())
+            .map_err(|m| {
+                self.err(BuildErrorKind::Invalid, key, format!("`{key}` is a motion, but {m}"))
+                    .hint("a motion needs exact ẋ and ẍ: write it of `t` and parameters, or read an input with `sea = {…}` or data with interp = \"spline\"")
+            })?;
+        if let Some(c) = m.constant() {
+            self.in_range(d, c)?;
+        }
+        Ok(m)
+    }
     fn count(&self, key: &str) -> Result<usize, BuildError> {
         let v = self.number(key)?;
         if v.fract() != 0.0 || !(0.0..=1e9).contains(&v) {
