@@ -88,8 +88,9 @@ pub struct WireSpec {
 }
 
 /// Outputs, in order.
-pub const PAYLOAD_OUTPUTS: [&str; 12] = [
+pub const PAYLOAD_OUTPUTS: [&str; 14] = [
     "x", "y", "vx", "vy", "T", "L", "stretch", "Fx", "Fy", "contact", "friction", "deck",
+    "tip_y", "tip_vy",
 ];
 const OUT_FX: usize = 7;
 
@@ -118,6 +119,8 @@ struct At {
     contact: f64,
     friction: f64,
     deck: f64,
+    /// The tip's height and vertical speed, inertial.
+    tip: [f64; 2],
 }
 
 /// The C¹ ramp: 0 for x ≤ 0, x²/2δ below δ, x − δ/2 beyond; and its slope.
@@ -245,6 +248,7 @@ impl WirePayload {
             contact,
             friction,
             deck,
+            tip: [tip_i.y, v_tip.y],
         }
     }
 
@@ -339,6 +343,8 @@ impl Element for WirePayload {
             a.contact,
             a.friction,
             a.deck,
+            a.tip[0],
+            a.tip[1],
         ];
         debug_assert_eq!(OUT_FX, 7);
         for (k, y) in v.into_iter().enumerate() {
