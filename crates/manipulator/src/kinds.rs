@@ -188,15 +188,50 @@ const LANDING: &[ParamDecl] = &[
 ];
 
 const PAYLOAD: &[ParamDecl] = &[
-    ParamDecl::choice("type", &["wire"], "wire", "a point mass on an elastic wire from the end of the last link"),
+    ParamDecl::choice(
+        "type",
+        &["wire"],
+        "wire",
+        "a point mass on an elastic wire from the end of the last link",
+    ),
     ParamDecl::number("mass", "kg", "payload mass").positive(),
     ParamDecl::number("EA", "N", "axial stiffness of the wire; k = EA/L").positive(),
-    ParamDecl::number("damping", "s", "Kelvin–Voigt time constant of the wire: c = damping·EA/L").non_negative().default(0.0),
-    ParamDecl::number("length", "m", "paid-out length (at the start, with a winch)").positive(),
-    ParamDecl::flag("winch", false, "a winch pays the wire out through the exposed port `wire` (tension, pay-out speed)"),
-    ParamDecl::number("slack_band", "m", "stretch over which the tension's slack/taut transition is smoothed (C¹)").positive().default(1e-6),
-    ParamDecl::flag("start_stretched", true, "start hanging at rest with the static stretch m g L/EA"),
-    ParamDecl::table("landing", LANDING, "a landing surface under the payload (Hunt–Crossley contact)").optional("none"),
+    ParamDecl::number(
+        "damping",
+        "s",
+        "Kelvin–Voigt time constant of the wire: c = damping·EA/L",
+    )
+    .non_negative()
+    .default(0.0),
+    ParamDecl::number(
+        "length",
+        "m",
+        "paid-out length (at the start, with a winch)",
+    )
+    .positive(),
+    ParamDecl::flag(
+        "winch",
+        false,
+        "a winch pays the wire out through the exposed port `wire` (tension, pay-out speed)",
+    ),
+    ParamDecl::number(
+        "slack_band",
+        "m",
+        "stretch over which the tension's slack/taut transition is smoothed (C¹)",
+    )
+    .positive()
+    .default(1e-6),
+    ParamDecl::flag(
+        "start_stretched",
+        true,
+        "start hanging at rest with the static stretch m g L/EA",
+    ),
+    ParamDecl::table(
+        "landing",
+        LANDING,
+        "a landing surface under the payload (Hunt–Crossley contact)",
+    )
+    .optional("none"),
 ];
 
 /// Kind `manipulator.planar_arm`.

@@ -99,7 +99,11 @@ fn wire_slack_payload_falls_freely_then_the_peak_tension_is_a_mass_caught_by_a_s
         if t < t_catch - 1e-3 {
             let free = x0[iy] - 0.5 * G * t * t;
             assert!((yk - free).abs() < 1e-7, "t {t}: y {yk} vs {free}");
-            assert!(tension[k].to_bits() == 0, "t {t}: slack wire pulls {}", tension[k]);
+            assert!(
+                tension[k].to_bits() == 0,
+                "t {t}: slack wire pulls {}",
+                tension[k]
+            );
         }
     }
     // ½ m v² + m g s = ½ k s²  ⇒  T_max = k s_max = m g + √((m g)² + k m v²)

@@ -89,8 +89,8 @@ pub struct WireSpec {
 
 /// Outputs, in order.
 pub const PAYLOAD_OUTPUTS: [&str; 14] = [
-    "x", "y", "vx", "vy", "T", "L", "stretch", "Fx", "Fy", "contact", "friction", "deck",
-    "tip_y", "tip_vy",
+    "x", "y", "vx", "vy", "T", "L", "stretch", "Fx", "Fy", "contact", "friction", "deck", "tip_y",
+    "tip_vy",
 ];
 const OUT_FX: usize = 7;
 
