@@ -24,6 +24,9 @@
 //! lumped_damping = "c_c"              # N·s/m, with "springs"
 //! paper_reactions = false             # also publish rho{k}_paper (springs only)
 //! geometric_stiffening = false        # keep the axial shortening of the bent links
+//! base = { y = "0.5*sin(0.7*t)", roll = "0.02*sin(0.5*t)" }   # a moving base (default: fixed)
+//! payload = { type = "wire", mass = "m3", EA = 5e7, length = 6, winch = true,
+//!             landing = { height = "-20 + 0.8*sin(0.6*t)", k = 1e8, lambda = 2e6 } }
 //! ```
 //!
 //! Links are numbered from 1 as in the paper. A link table has `type` = `"beam"` (length, E,
@@ -198,6 +201,83 @@ const LUMPED_MASS: &[ParamDecl] = &[
     ParamDecl::number("mass", "kg", "mass").positive(),
 ];
 
+const BASE: &[ParamDecl] = &[
+    ParamDecl::modulated(
+        "x",
+        "m",
+        "horizontal position of joint 1, an expression of t",
+    )
+    .default(0.0),
+    ParamDecl::modulated(
+        "y",
+        "m",
+        "vertical position of joint 1 (up), an expression of t",
+    )
+    .default(0.0),
+    ParamDecl::modulated(
+        "roll",
+        "rad",
+        "roll of the base frame (counter-clockwise), an expression of t",
+    )
+    .default(0.0),
+];
+
+const LANDING: &[ParamDecl] = &[
+    ParamDecl::modulated("height", "m", "height of the landing surface (inertial, up), an expression of t").default(0.0),
+    ParamDecl::number("k", "", "contact stiffness k of F = k δⁿ + λ δⁿ δ̇ (N/mⁿ)").positive(),
+    ParamDecl::number("n", "", "contact exponent n (1.5: Hertz)").positive().default(1.5),
+    ParamDecl::number("lambda", "", "Hunt–Crossley damping λ (N·s/mⁿ⁺¹); λ = 3k(1 − e)/(2 v) for a restitution e at impact speed v").non_negative().default(0.0),
+    ParamDecl::number("mu", "", "Coulomb friction coefficient").non_negative().default(0.0),
+    ParamDecl::number("slip_speed", "m/s", "sliding speed over which friction builds up (tanh)").positive().default(0.01),
+];
+
+const PAYLOAD: &[ParamDecl] = &[
+    ParamDecl::choice(
+        "type",
+        &["wire"],
+        "wire",
+        "a point mass on an elastic wire from the end of the last link",
+    ),
+    ParamDecl::number("mass", "kg", "payload mass").positive(),
+    ParamDecl::number("EA", "N", "axial stiffness of the wire; k = EA/L").positive(),
+    ParamDecl::number(
+        "damping",
+        "s",
+        "Kelvin–Voigt time constant of the wire: c = damping·EA/L",
+    )
+    .non_negative()
+    .default(0.0),
+    ParamDecl::number(
+        "length",
+        "m",
+        "paid-out length (at the start, with a winch)",
+    )
+    .positive(),
+    ParamDecl::flag(
+        "winch",
+        false,
+        "a winch pays the wire out through the exposed port `wire` (tension, pay-out speed)",
+    ),
+    ParamDecl::number(
+        "slack_band",
+        "m",
+        "stretch over which the tension's slack/taut transition is smoothed (C¹)",
+    )
+    .positive()
+    .default(1e-6),
+    ParamDecl::flag(
+        "start_stretched",
+        true,
+        "start hanging at rest with the static stretch m g L/EA",
+    ),
+    ParamDecl::table(
+        "landing",
+        LANDING,
+        "a landing surface under the payload (Hunt–Crossley contact)",
+    )
+    .optional("none"),
+];
+
 /// Kind `manipulator.planar_arm`.
 pub const PLANAR_ARM: KindDecl = KindDecl::composite(
     "manipulator.planar_arm",
@@ -224,6 +304,8 @@ pub const PLANAR_ARM: KindDecl = KindDecl::composite(
         ParamDecl::count("stress_grid", "equally spaced sections per link published as grid{k}.* (bg-sim stress sets it)")
             .range(Range::closed(0.0, 4096.0))
             .default(0.0),
+        ParamDecl::table("payload", PAYLOAD, "a payload on an elastic wire of varying length from the end of the last link (docs/offshore.md)").optional("none"),
+        ParamDecl::table("base", BASE, "a moving base (a vessel): the ground frame's position and roll as functions of time (docs/offshore.md)").optional("fixed"),
     ],
     build_planar_arm,
 )
@@ -560,6 +642,40 @@ fn scene(p: &dyn Params) -> Result<ArmScene, BuildError> {
         });
     }
     scene.paper_reactions = p.flag("paper_reactions")?;
+    if let Some(t) = p.table("payload")? {
+        let at = |e: BuildError| e.within("payload");
+        let landing = match t.table("landing").map_err(at)? {
+            None => None,
+            Some(l) => {
+                let at = |e: BuildError| e.within("payload.landing");
+                Some(crate::elements::Landing {
+                    height: l.motion("height").map_err(at)?,
+                    stiffness: l.number("k").map_err(at)?,
+                    exponent: l.number("n").map_err(at)?,
+                    damping: l.number("lambda").map_err(at)?,
+                    friction: l.number("mu").map_err(at)?,
+                    slip_speed: l.number("slip_speed").map_err(at)?,
+                })
+            }
+        };
+        scene.payload = Some(crate::elements::WireSpec {
+            mass: t.number("mass").map_err(at)?,
+            ea: t.number("EA").map_err(at)?,
+            damping: t.number("damping").map_err(at)?,
+            length: t.number("length").map_err(at)?,
+            winch: t.flag("winch").map_err(at)?,
+            slack_band: t.number("slack_band").map_err(at)?,
+            start_stretched: t.flag("start_stretched").map_err(at)?,
+            landing,
+        });
+    }
+    if let Some(b) = p.table("base")? {
+        scene.base = Some(crate::base::Base {
+            x: b.motion("x").map_err(|e| e.within("base"))?,
+            y: b.motion("y").map_err(|e| e.within("base"))?,
+            roll: b.motion("roll").map_err(|e| e.within("base"))?,
+        });
+    }
     // The spring parameters are read whatever the model, so that `--set` can switch
     // `lumped_model` alone.
     let stiffness = p.optional("lumped_stiffness")?;

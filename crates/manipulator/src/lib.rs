@@ -55,6 +55,7 @@ pub mod screw;
 
 // The arm (section 3.1)
 pub mod arm;
+pub mod base;
 pub mod joint;
 pub mod link;
 pub mod mode_shape;
@@ -95,6 +96,7 @@ pub mod scene;
 
 pub use actuator::LinearActuator;
 pub use arm::{Frames, PlanarArm, Pose, Station};
+pub use base::{Base, BaseState};
 pub use elements::{
     lumped_masses, ActuatorTransformer, ArmCompliance, ArmDamping, ArmInertia, ArmReactions,
     LumpedGravity, LumpedMassTransformer,

@@ -100,8 +100,23 @@ impl ArmKinematics<'_> {
         rigid_masses: &[(Station, f64)],
         rho: &mut [f64],
     ) {
+        let weight = Vector2::new(0.0, self.arm().gravity());
+        self.reactions_in_field_into(u, u_dot, loads, rigid_masses, weight, rho);
+    }
+
+    /// As [`reactions_into`](Self::reactions_into) in a uniform field of acceleration
+    /// `−weight` (frame 0; gravity is `weight = (0, g)`): on a moving base
+    /// ([`base`](crate::base)) the apparent gravity, with the absolute speeds.
+    pub fn reactions_in_field_into<'s>(
+        &self,
+        u: &[f64],
+        u_dot: &[f64],
+        loads: impl IntoIterator<Item = (&'s Station, Vector2<f64>)>,
+        rigid_masses: &[(Station, f64)],
+        weight: Vector2<f64>,
+        rho: &mut [f64],
+    ) {
         let arm = self.arm();
-        let weight = Vector2::new(0.0, arm.gravity());
         rho.fill(0.0);
         // Σ (m a − m g⃗) of link i (frame 0), onto every joint j ≤ i.
         let add = |i: usize, f: Vector2<f64>, rho: &mut [f64]| {

@@ -31,11 +31,14 @@ use nalgebra::DVector;
 
 use crate::actuator::LinearActuator;
 use crate::arm::PlanarArm;
+use crate::base::Base;
 use crate::elements::ReactionInputs;
 use crate::elements::{
     ActuatorTransformer, ArmCompliance, ArmDamping, ArmInertia, ArmReactions, LumpedGravity,
     LumpedMassTransformer,
 };
+use crate::elements::{BaseLoads, BaseMotion, BASE_OUTPUTS, OUT_ALPHA, OUT_FIELD, OUT_OMEGA};
+use crate::elements::{WirePayload, WireSpec, PAYLOAD_OUTPUTS};
 use crate::link::{Link, PointMass};
 use crate::lumped_mass::LumpedMass;
 use crate::quadrature::GaussLegendre;
@@ -88,6 +91,13 @@ pub struct ArmScene {
     pub stress_at: Vec<(usize, f64)>,
     /// Equally spaced sections per link published as vectors `grid{k}.*` (0: none).
     pub stress_grid: usize,
+    /// The moving base ([`base`](crate::base)), if any: adds the members `base` (its motion
+    /// as signals), `inertial` (the loads of its acceleration) and the pedestal's reaction.
+    pub base: Option<Base>,
+    /// A payload on an elastic wire from the end of the last chord
+    /// ([`WirePayload`](crate::elements::WirePayload)): the member `payload`, with the
+    /// exposed port `wire` when a winch pays it out.
+    pub payload: Option<WireSpec>,
 }
 
 /// Pad `v` with zeros to length `n`, or complain that it is longer.
@@ -122,6 +132,8 @@ impl ArmScene {
             sections: Vec::new(),
             stress_at: Vec::new(),
             stress_grid: 0,
+            base: None,
+            payload: None,
         }
     }
 
@@ -171,7 +183,38 @@ impl ArmScene {
         }
         let q = format!("{}.q", member("arm"));
         let mut c = Composite::default();
-        c.element("arm", ArmInertia::new(arm.clone(), q0.clone(), u0.clone())?)
+        let mut inertia = ArmInertia::new(arm.clone(), q0.clone(), u0.clone())?;
+        let base_signal = |k: usize| format!("{}.{}", member("base"), BASE_OUTPUTS[k]);
+        if let Some(base) = &self.base {
+            if arm.has_geometric_stiffening() {
+                return Err(ParamError::shape(
+                    "base",
+                    "a moving base is not combined with geometric_stiffening yet",
+                ));
+            }
+            if !springs.is_empty() {
+                return Err(ParamError::shape(
+                    "base",
+                    "a moving base needs the lumped masses rigid or left out (lumped_model = \"rigid\" or \"none\"): the loads of the base's roll on masses hanging on springs are not modelled",
+                ));
+            }
+            if base.rolls() {
+                let omega0 = base.roll.eval(0.0)[1];
+                inertia =
+                    inertia.on_rolling_base(base_signal(OUT_OMEGA), base_signal(OUT_ALPHA), omega0);
+            }
+            c.element("base", BaseMotion::new(base.clone(), self.gravity))
+                .element(
+                    "inertial",
+                    BaseLoads::new(
+                        arm.clone(),
+                        &q,
+                        [base_signal(OUT_FIELD), base_signal(OUT_FIELD + 1)],
+                    ),
+                )
+                .bond("b_inertial", "j", "inertial");
+        }
+        c.element("arm", inertia)
             .element("j", OneJunction)
             .element("c", ArmCompliance::new(arm.clone(), &q))
             .element("r", ArmDamping::new(damping)?);
@@ -224,6 +267,20 @@ impl ArmScene {
                 .bond("b_masses", "masses_j", "masses");
             pin_forces = Some(format!("{}.2.e", member("lump")));
         }
+        let mut tip_load = None;
+        if let Some(spec) = &self.payload {
+            let base = self.base.clone().unwrap_or_else(Base::still);
+            c.element(
+                "payload",
+                WirePayload::new(arm.clone(), spec.clone(), base, self.gravity, &q, &q0)?,
+            )
+            .bond("b_payload", "j", "payload.1");
+            if spec.winch {
+                c.port("wire", "payload.wire");
+            }
+            let out = |k: usize| format!("{}.{}", member("payload"), PAYLOAD_OUTPUTS[k]);
+            tip_load = Some([out(7), out(8)]);
+        }
         let arm_name = member("arm");
         let inputs = ReactionInputs {
             q: q.clone(),
@@ -231,6 +288,15 @@ impl ArmScene {
             udot: format!("{arm_name}.udot"),
             forces,
             pin_forces,
+            base: self.base.as_ref().map(|_| {
+                [
+                    base_signal(OUT_OMEGA),
+                    base_signal(OUT_ALPHA),
+                    base_signal(OUT_FIELD),
+                    base_signal(OUT_FIELD + 1),
+                ]
+            }),
+            tip_load,
         };
         if !self.stress_at.is_empty() || self.stress_grid > 0 {
             // only when asked for: the block is read by outputs alone (docs/stress.md)

@@ -67,6 +67,9 @@ pub struct ArmInertia {
     ends: Vec<Station>,
     /// (coordinate name, speed name, index in q or `None` for an unmodelled mode).
     named: Vec<(String, String, Option<usize>)>,
+    /// With a rolling base ([`base`](crate::base)): the signals θ̇ and θ̈. The state is then
+    /// the absolute momentum `p = M(q)(u + θ̇ e₁)`, and the flow the relative speed u.
+    roll: Option<[String; 2]>,
     ws: RefCell<Motion>,
 }
 
@@ -367,7 +370,33 @@ impl ArmInertia {
             mid,
             ends,
             named,
+            roll: None,
         })
+    }
+
+    /// On a rolling base: the state becomes the absolute momentum `p = M(q)(u + θ̇ e₁)`
+    /// (starting with `p₀ = M(q₀)(u₀ + omega0 e₁)`), the flow and `q̇` the relative speed
+    /// `M⁻¹p − θ̇ e₁`, and `udot` the relative acceleration; θ̇ and θ̈ are read from the
+    /// signals `omega` and `alpha` ([`base`](crate::base)).
+    #[must_use]
+    pub fn on_rolling_base(mut self, omega: String, alpha: String, omega0: f64) -> Self {
+        // p₀ = M u₀ + omega0 M e₁
+        let m = self.arm.kinematics(&self.q0).mass_matrix();
+        for (k, p) in self.p0.iter_mut().enumerate() {
+            *p += omega0 * m[(k, 0)];
+        }
+        self.roll = Some([omega, alpha]);
+        self
+    }
+
+    /// θ̇ now (0 without a rolling base).
+    #[inline]
+    fn omega(&self, io: &Io<'_>) -> f64 {
+        if self.roll.is_some() {
+            io.u(0)
+        } else {
+            0.0
+        }
     }
 
     /// The arm.
@@ -404,6 +433,13 @@ impl Element for ArmInertia {
             .map(|(name, &q)| StateSpec::new(&name, q));
         p.chain(q).collect()
     }
+    fn signal_inputs(&self) -> Vec<SignalSpec> {
+        self.roll
+            .iter()
+            .flatten()
+            .map(|s| SignalSpec::scalar(s))
+            .collect()
+    }
     fn signal_outputs(&self) -> Vec<SignalSpec> {
         let n = self.arm.n();
         let mut out = vec![
@@ -432,14 +468,21 @@ impl Element for ArmInertia {
         let first = self.first_named_output();
         let mut geometry = vec![Slot::Output(OUT_T)];
         geometry.extend((OUT_LINKS..first).map(Slot::Output));
+        let (omega, alpha) = if self.roll.is_some() {
+            (vec![Slot::Input(0)], vec![Slot::Input(1)])
+        } else {
+            (Vec::new(), Vec::new())
+        };
+        let mut udot = vec![Slot::Effort(0)];
+        udot.extend(alpha);
         vec![
             Stage {
                 writes: vec![Slot::Flow(0), Slot::Output(OUT_U)],
-                reads: Vec::new(),
+                reads: omega.clone(),
             },
             Stage {
                 writes: vec![Slot::Output(OUT_UDOT)],
-                reads: vec![Slot::Effort(0)],
+                reads: udot,
             },
             Stage {
                 writes: geometry,
@@ -449,7 +492,7 @@ impl Element for ArmInertia {
                 writes: (first..first + 2 * self.named.len())
                     .map(Slot::Output)
                     .collect(),
-                reads: Vec::new(),
+                reads: omega,
             },
         ]
     }
@@ -463,11 +506,19 @@ impl Element for ArmInertia {
                     io.set_f_in(0, k, uk);
                     io.set_y(OUT_U, k, uk);
                 }
+                if self.roll.is_some() {
+                    let u1 = state.u[0] - io.u(0);
+                    io.set_f_in(0, 0, u1);
+                    io.set_y(OUT_U, 0, u1);
+                }
             }
             1 => {
                 let udot = ws.accelerations(&self.arm, io.states(), |k| io.e(0, k));
                 for (k, &a) in udot.iter().enumerate() {
                     io.set_y(OUT_UDOT, k, a);
+                }
+                if self.roll.is_some() {
+                    io.set_y(OUT_UDOT, 0, udot[0] - io.u(1));
                 }
             }
             2 => {
@@ -489,10 +540,16 @@ impl Element for ArmInertia {
                 }
             }
             _ => {
+                let omega = self.omega(io);
                 let (x, state) = ws.state(&self.arm, io.states());
                 let first = self.first_named_output();
                 for (j, (_, _, index)) in self.named.iter().enumerate() {
                     let (q, v) = index.map_or((0.0, 0.0), |k| (x[n + k], state.u[k]));
+                    let v = if index == &Some(0) && self.roll.is_some() {
+                        v - omega
+                    } else {
+                        v
+                    };
                     io.set_y(first + 2 * j, 0, q);
                     io.set_y(first + 2 * j + 1, 0, v);
                 }
@@ -506,6 +563,9 @@ impl Element for ArmInertia {
         for k in 0..n {
             dx[k] = io.e(0, k) + state.e[k];
             dx[n + k] = state.u[k];
+        }
+        if self.roll.is_some() {
+            dx[n] -= io.u(0);
         }
     }
     fn stage_partials(&self, stage: usize, io: &Io<'_>, jac: &mut LocalJacobian<'_>) -> bool {
@@ -528,6 +588,11 @@ impl Element for ArmInertia {
                 for k in 0..n {
                     speed_row(jac, jac.row(Slot::Flow(0), k), k);
                     speed_row(jac, jac.row(Slot::Output(OUT_U), k), k);
+                }
+                if self.roll.is_some() {
+                    for slot in [Slot::Flow(0), Slot::Output(OUT_U)] {
+                        jac.set(jac.row(slot, 0), jac.input_col(0, 0), -1.0);
+                    }
                 }
             }
             1 => return false,
@@ -573,7 +638,11 @@ impl Element for ArmInertia {
                     if let Some(k) = *index {
                         let row = jac.row(Slot::Output(first + 2 * j), 0);
                         jac.set(row, jac.state_col(n + k), 1.0);
-                        speed_row(jac, jac.row(Slot::Output(first + 2 * j + 1), 0), k);
+                        let speed = jac.row(Slot::Output(first + 2 * j + 1), 0);
+                        speed_row(jac, speed, k);
+                        if k == 0 && self.roll.is_some() {
+                            jac.set(speed, jac.input_col(0, 0), -1.0);
+                        }
                     }
                 }
             }
@@ -590,6 +659,9 @@ impl Element for ArmInertia {
             jac.set(row, jac.effort_col(0, r), 1.0);
             set_row(jac, row, &d.pdot[w.clone()]);
             set_row(jac, jac.derivative_row(n + r), &d.speed[w]);
+        }
+        if self.roll.is_some() {
+            jac.set(jac.derivative_row(n), jac.input_col(0, 0), -1.0);
         }
         true
     }

@@ -36,6 +36,14 @@ pub struct ReactionInputs {
     pub forces: Vec<String>,
     /// The pin forces of the lumped masses on springs (`lump.2.e`), if any.
     pub pin_forces: Option<String>,
+    /// On a moving base ([`base`](crate::base)): the signals θ̇, θ̈ and the apparent
+    /// gravity's x, y in the base's axes. The block then also publishes the pedestal's
+    /// reaction `F_ped_x`, `F_ped_y` (N, base axes) and `M_ped` (N·m, about joint 1,
+    /// counter-clockwise): the load of the arm on the vessel.
+    pub base: Option<[String; 4]>,
+    /// A force on the end of the last chord (base axes, a 2-signal pair: the wire's pull,
+    /// `payload.Fx`, `payload.Fy`), if any.
+    pub tip_load: Option<[String; 2]>,
 }
 
 /// The reaction-force block of a [`PlanarArm`].
@@ -46,6 +54,8 @@ pub struct ArmReactions {
     /// Per actuator, its pins (a, b) resolved on the arm.
     acts: Vec<(PinPoint, PinPoint)>,
     springs: Vec<(Station, f64)>,
+    /// The end of the last chord (where a tip load acts).
+    tip: Station,
     paper: bool,
     ws: RefCell<Workspace>,
 }
@@ -63,6 +73,12 @@ struct Workspace {
     /// ρ, then the paper's variant.
     rho: Vec<f64>,
     rho_paper: Vec<f64>,
+    /// With a moving base: the reactions without loads, M, E, Ṁu and the field forces.
+    all: Vec<f64>,
+    m: nalgebra::DMatrix<f64>,
+    e: Vec<f64>,
+    mdot_u: Vec<f64>,
+    g: Vec<f64>,
 }
 
 impl ArmReactions {
@@ -95,7 +111,10 @@ impl ArmReactions {
             })
             .collect::<Result<_, ParamError>>()?;
         let (n, n_rho) = (arm.n(), 2 * arm.n_links());
+        let last = arm.n_links() - 1;
+        let tip = arm.station(last, arm.links()[last].length())?;
         Ok(Self {
+            tip,
             ws: RefCell::new(Workspace {
                 frames: arm.frames(),
                 q: vec![0.0; n],
@@ -104,6 +123,15 @@ impl ArmReactions {
                 act_forces: vec![Vector2::zeros(); acts.len()],
                 rho: vec![0.0; n_rho],
                 rho_paper: vec![0.0; n_rho],
+                all: vec![0.0; if inputs.base.is_some() { n_rho } else { 0 }],
+                m: if inputs.base.is_some() {
+                    nalgebra::DMatrix::zeros(n, n)
+                } else {
+                    nalgebra::DMatrix::zeros(0, 0)
+                },
+                e: vec![0.0; n],
+                mdot_u: vec![0.0; n],
+                g: vec![0.0; n],
             }),
             arm,
             inputs,
@@ -151,6 +179,8 @@ impl Element for ArmReactions {
         if let Some(p) = &self.inputs.pin_forces {
             s.push(v(p, 2 * self.springs.len()));
         }
+        s.extend(self.inputs.base.iter().flatten().map(|b| v(b, 1)));
+        s.extend(self.inputs.tip_load.iter().flatten().map(|b| v(b, 1)));
         s
     }
     fn signal_outputs(&self) -> Vec<SignalSpec> {
@@ -159,6 +189,9 @@ impl Element for ArmReactions {
             .collect();
         if self.paper {
             out.extend((1..=self.n_rho()).map(|k| SignalSpec::scalar(&format!("rho{k}_paper"))));
+        }
+        if self.inputs.base.is_some() {
+            out.extend(["F_ped_x", "F_ped_y", "M_ped"].map(SignalSpec::scalar));
         }
         out
     }
@@ -172,10 +205,22 @@ impl Element for ArmReactions {
             act_forces,
             rho,
             rho_paper,
+            all,
+            m,
+            e,
+            mdot_u,
+            g,
         } = &mut *ws;
         q.copy_from_slice(io.input(0));
         u.copy_from_slice(io.input(1));
         udot.copy_from_slice(io.input(2));
+        let first_base = 3 + self.acts.len() + usize::from(self.inputs.pin_forces.is_some());
+        let field = self.inputs.base.as_ref().map(|_| {
+            // absolute speeds: the base's roll is a turn of joint 1
+            u[0] += io.u(first_base);
+            udot[0] += io.u(first_base + 1);
+            nalgebra::Vector2::new(io.u(first_base + 2), io.u(first_base + 3))
+        });
         let kin = ArmKinematics::new(self.arm.pose_in(q, frames));
         let pose = kin.pose();
         for (c, (a, b)) in self.acts.iter().enumerate() {
@@ -193,6 +238,13 @@ impl Element for ArmReactions {
                         .filter_map(|(s, f)| s.map(|s| (s, f)))
                 })
         };
+        let first_tip = first_base + 4 * usize::from(self.inputs.base.is_some());
+        let tip_load = self.inputs.tip_load.as_ref().map(|_| {
+            (
+                &self.tip,
+                Vector2::new(io.u(first_tip), io.u(first_tip + 1)),
+            )
+        });
         let pin_forces = self
             .inputs
             .pin_forces
@@ -203,15 +255,55 @@ impl Element for ArmReactions {
             .iter()
             .enumerate()
             .map(|(k, (s, _))| (s, Vector2::new(pin_forces[2 * k], pin_forces[2 * k + 1])));
-        kin.reactions_into(u, udot, act_loads().chain(spring_loads), &[], rho);
+        let weight = field.map_or(Vector2::new(0.0, self.arm.gravity()), |f| -f);
+        kin.reactions_in_field_into(
+            u,
+            udot,
+            act_loads().chain(spring_loads).chain(tip_load),
+            &[],
+            weight,
+            rho,
+        );
         if self.paper {
             if self.springs.is_empty() {
                 rho_paper.copy_from_slice(rho);
             } else {
-                kin.reactions_into(u, udot, act_loads(), &self.springs, rho_paper);
+                kin.reactions_in_field_into(
+                    u,
+                    udot,
+                    act_loads().chain(tip_load),
+                    &self.springs,
+                    weight,
+                    rho_paper,
+                );
             }
         }
+        let pedestal = field.map(|f| {
+            // the force on the whole arm from the vessel: Σ m (a − f), frame 0
+            kin.reactions_in_field_into(u, udot, std::iter::empty(), &[], weight, all);
+            let mut force = kin.pose().to_base(0, &Vector2::new(all[0], all[1]));
+            // less the wire's pull: the rest comes from the vessel
+            g.fill(0.0);
+            if let Some((s, f)) = tip_load {
+                force -= f;
+                kin.pose().add_point_force(s, &f, g);
+            }
+            let wire_moment = g[0];
+            // the moment about joint 1: Q₁ = (M u̇_a + Ṁ u_a − E(u_a))₁ − G(q; f)₁
+            kin.mass_matrix_into(m);
+            kin.kinetic_terms_into(u, e, Some(mdot_u));
+            kin.field_forces_into(&f, g);
+            let m_u: f64 = (0..u.len()).map(|k| m[(0, k)] * udot[k]).sum();
+            let moment = m_u + mdot_u[0] - e[0] - g[0] - wire_moment;
+            [-force.x, -force.y, -moment]
+        });
         drop(kin);
+        if let Some(ped) = pedestal {
+            let first = self.n_rho() * if self.paper { 2 } else { 1 };
+            for (k, v) in ped.into_iter().enumerate() {
+                io.set_y(first + k, 0, v);
+            }
+        }
         for (k, r) in rho.iter().enumerate() {
             io.set_y(k, 0, *r);
         }
