@@ -300,6 +300,17 @@ impl ArmScene {
         };
         if !self.stress_at.is_empty() || self.stress_grid > 0 {
             // only when asked for: the block is read by outputs alone (docs/stress.md)
+            if self.base.is_some() || self.payload.is_some() {
+                // the free body of docs/stress.md sums the loads of a fixed base and a rigid
+                // pendulum payload; the inertial field of a moving base and the wire's
+                // tension are not among them yet
+                return Err(ParamError::shape(
+                    "stress_at",
+                    "stress recovery is not combined with a moving `base` or a wire `payload` yet: \
+                     remove the stress outputs (or `stress_at`), or run the scene on a fixed base \
+                     with the rigid payload",
+                ));
+            }
             let joints = padded("damping", &self.damping, n)?[..arm.n_links()].to_vec();
             c.element(
                 "stress",
