@@ -16,6 +16,7 @@ use commands::{
     bench, check, compare, energy, fmu, graph, kinds, linearize, modes, plot, reduce, run, sweep,
     FAILED,
 };
+use commands::fit;
 
 #[derive(Parser)]
 #[command(
@@ -74,6 +75,9 @@ enum Command {
     /// Export the model as an FMI 2.0 (or --fmi 3) co-simulation FMU: the model and its data
     /// in resources/, the engine library (`cargo build -p bg-fmu`) in binaries/ (docs/fmu.md).
     Fmu(fmu::Args),
+    /// Fit parameters to measured data (weighted least squares, bounded Levenberg–Marquardt):
+    /// estimates, standard errors, 95 % intervals, correlations, warnings (docs/fit.md).
+    Fit(fit::Args),
 }
 
 fn main() -> ExitCode {
@@ -120,5 +124,6 @@ fn dispatch(command: Command) -> ExitCode {
         Command::Compare(a) => compare::command(&a),
         Command::Plot(a) => plot::command(&a),
         Command::Fmu(a) => fmu::command(&a),
+        Command::Fit(a) => fit::command(a),
     }
 }

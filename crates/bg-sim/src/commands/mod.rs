@@ -9,6 +9,7 @@ pub mod bench;
 pub mod check;
 pub mod compare;
 pub mod energy;
+pub mod fit;
 pub mod fmu;
 pub mod graph;
 pub mod json;
