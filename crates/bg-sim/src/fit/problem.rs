@@ -310,6 +310,14 @@ impl Problem {
                     .hint(format!("give the start: {}={}..{}@START", p.name, p.lo, p.hi)))
                 }
             };
+            // and the model must build with it (an element's parameter that its kind has)
+            if !p.path.starts_with("parameters.") {
+                Model::from_text(&file, &text, &reg, &[format!("{}={s:?}", p.path)]).map_err(|e| {
+                    let mut e = e;
+                    e.message = format!("--param `{}`: {}", p.name, e.message);
+                    e
+                })?;
+            }
             start.push(s);
         }
         let model_outputs: Vec<String> = model.outputs.iter().map(|o| o.name.clone()).collect();
