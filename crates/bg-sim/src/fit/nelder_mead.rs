@@ -138,7 +138,7 @@ impl SplitMix {
 /// A particle swarm (inertia 0.7298, pulls 1.49618 to the particle's best and the swarm's:
 /// Clerc's constriction) of `particles` in the box, `generations` at most, each
 /// generation's particles evaluated in parallel on the current rayon pool. Stops early when
-/// the swarm's best has not improved by `ftol` (relative) in 5 generations. Seeded.
+/// the swarm's best has not improved by `ftol` (relative) in 15 generations. Seeded.
 pub fn particle_swarm(
     f: &(dyn Fn(&[f64]) -> f64 + Sync),
     p0: Option<&[f64]>,
@@ -195,7 +195,7 @@ pub fn particle_swarm(
         history.push(best_f[g]);
         if before - best_f[g] <= ftol * before.abs().max(1e-300) {
             stale += 1;
-            if stale >= 5 {
+            if stale >= 15 {
                 converged = true;
                 break;
             }
