@@ -16,7 +16,7 @@ use commands::{
     bench, check, compare, energy, fmu, graph, kinds, linearize, modes, plot, reduce, run, sweep,
     FAILED,
 };
-use commands::fit;
+use commands::{fit, optimize};
 
 #[derive(Parser)]
 #[command(
@@ -78,6 +78,9 @@ enum Command {
     /// Fit parameters to measured data (weighted least squares, bounded Levenberg–Marquardt):
     /// estimates, standard errors, 95 % intervals, correlations, warnings (docs/fit.md).
     Fit(fit::Args),
+    /// Minimise a sweep metric subject to constraints on others over bounded parameters, by a
+    /// particle swarm (or Nelder–Mead) whose runs go in parallel (docs/fit.md).
+    Optimize(optimize::Args),
 }
 
 fn main() -> ExitCode {
@@ -125,5 +128,6 @@ fn dispatch(command: Command) -> ExitCode {
         Command::Plot(a) => plot::command(&a),
         Command::Fmu(a) => fmu::command(&a),
         Command::Fit(a) => fit::command(a),
+        Command::Optimize(a) => optimize::command(&a),
     }
 }

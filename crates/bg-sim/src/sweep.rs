@@ -28,6 +28,7 @@
 
 mod csv;
 mod design;
+pub mod optimize;
 mod run;
 mod spec;
 mod summary;

@@ -16,6 +16,7 @@ pub mod json;
 pub mod kinds;
 pub mod linearize;
 pub mod modes;
+pub mod optimize;
 pub mod plot;
 pub mod reduce;
 pub mod run;
