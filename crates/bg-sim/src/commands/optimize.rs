@@ -86,7 +86,8 @@ pub fn command(a: &Args) -> ExitCode {
 
 fn history_plot(history: &[f64], objective: &str, png: &std::path::Path) -> Result<(), String> {
     use bg_model::plots::{Panel, Plot, Series};
-    let mut csv = String::from("generation,best\n");
+    // the figure's x column is `t` by the plot module's rule; here it counts generations
+    let mut csv = String::from("t,best\n");
     for (g, s) in history.iter().enumerate() {
         // infeasible generations (score ≥ 1e20) are left out of the curve
         if *s < 1e19 {
@@ -97,7 +98,7 @@ fn history_plot(history: &[f64], objective: &str, png: &std::path::Path) -> Resu
     let plot = Plot {
         file: png.file_stem().map_or_else(|| "history".into(), |s| s.to_string_lossy().into_owned()),
         title: format!("Optimisation history: best {objective} (feasible runs)"),
-        x: "generation".into(),
+        x: "t".into(),
         x_label: "generation".into(),
         panels: vec![Panel {
             y_label: objective.to_owned(),

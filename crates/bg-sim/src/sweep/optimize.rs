@@ -1,6 +1,9 @@
 //! Design optimisation over a sweep's metrics: `bg-sim optimize MODEL --spec OPT.toml`.
 //!
 //! ```toml
+//! [set]                     # fixed changes to the model first (any --set path), optional
+//! "parameters.d1" = 0.24
+//! "elements.cyl1.a_p" = "pi/4*d1^2"
 //! [optimize]
 //! method = "swarm"          # particle swarm (parallel), or "nelder-mead"
 //! particles = 12            # swarm size (runs per generation, in parallel)
@@ -55,6 +58,8 @@ pub struct Constraint {
 /// A parsed optimisation spec.
 #[derive(Clone, Debug)]
 pub struct OptSpec {
+    /// Fixed `--set` overrides applied to the model first.
+    pub set: Vec<String>,
     /// `--set` path, lower and upper bound, start.
     pub parameters: Vec<(String, f64, f64, Option<f64>)>,
     /// The metrics.
@@ -92,10 +97,10 @@ pub fn parse_opt_spec(file: &str, text: &str) -> Result<OptSpec, SweepError> {
         .parse()
         .map_err(|e: toml::de::Error| err(file, format!("not a valid TOML optimisation spec: {}", e.message())))?;
     for k in table.keys() {
-        if !["optimize", "parameters", "metrics", "objective", "constraints"].contains(&k.as_str()) {
+        if !["set", "optimize", "parameters", "metrics", "objective", "constraints"].contains(&k.as_str()) {
             return Err(err(
                 file,
-                format!("unknown section `{k}`; an optimisation spec has [optimize], [parameters], [metrics], [objective] and [constraints]"),
+                format!("unknown section `{k}`; an optimisation spec has [set], [optimize], [parameters], [metrics], [objective] and [constraints]"),
             ));
         }
     }
@@ -181,7 +186,19 @@ pub fn parse_opt_spec(file: &str, text: &str) -> Result<OptSpec, SweepError> {
         }
         constraints.push(Constraint { metric, min, max });
     }
+    let mut set = Vec::new();
+    for (k, v) in &sub("set")? {
+        let v = match v {
+            toml::Value::String(t) => t.clone(),
+            other => match num(other) {
+                Some(x) => format!("{x:?}"),
+                None => return Err(err(file, format!("[set] `{k}`: a number or a string"))),
+            },
+        };
+        set.push(format!("{k}={v}"));
+    }
     Ok(OptSpec {
+        set,
         parameters,
         metrics,
         objective,
@@ -304,6 +321,26 @@ pub fn optimize(
     })
 }
 
+/// Add the `parameters.NAME=…` entries of `set` that the model's `[parameters]` lacks
+/// (a design variable of the optimisation's own, such as cylinder 1's bore), with a
+/// placeholder value that `--set` then replaces.
+fn with_new_parameters(text: &str, set: &[String]) -> Result<String, String> {
+    let mut doc: toml_edit::DocumentMut = text.parse().map_err(|e: toml_edit::TomlError| e.to_string())?;
+    let Some(params) = doc.get_mut("parameters").and_then(toml_edit::Item::as_table_mut) else {
+        return Ok(text.to_owned());
+    };
+    let mut added = false;
+    for o in set {
+        if let Some((name, _)) = o.split_once('=').and_then(|(k, v)| k.trim().strip_prefix("parameters.").map(|n| (n, v))) {
+            if !name.contains('.') && !params.contains_key(name) {
+                params.insert(name, toml_edit::value(0.0));
+                added = true;
+            }
+        }
+    }
+    Ok(if added { doc.to_string() } else { text.to_owned() })
+}
+
 /// Read the spec and model and [`optimize`].
 ///
 /// # Errors
@@ -315,6 +352,9 @@ pub fn optimize_files(model: &Path, spec_path: &Path, registry: fn() -> Registry
     let file = model.display().to_string();
     bg_model::Model::load(model, &registry(), &[]).map_err(|e| err(&file, e.to_string()))?;
     let text = std::fs::read_to_string(model).map_err(|e| err(&file, format!("cannot read the model: {e}")))?;
+    let text = with_new_parameters(&text, &spec.set).map_err(|m| err(&sf, format!("[set]: {m}")))?;
+    let text = bg_model::overrides::apply(&file, &text, &spec.set).map_err(|e| err(&sf, format!("[set]: {e}")))?;
+    bg_model::Model::from_text(&file, &text, &registry(), &[]).map_err(|e| err(&sf, format!("the model with [set]: {e}")))?;
     let opt = optimize(&file, &text, registry, &spec)?;
     Ok((spec, opt))
 }
