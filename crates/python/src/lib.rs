@@ -6,6 +6,7 @@
 //! `Model` holds `RefCell`s and cannot cross threads, while a path and a list of strings
 //! pickle, so the same calls run on Dask workers. Loading costs milliseconds.
 
+mod fit;
 mod stepping;
 
 use std::path::{Path, PathBuf};
@@ -329,4 +330,6 @@ mod _bgsim {
     use super::stepping::{linearize, start, Sim};
     #[pymodule_export]
     use super::{describe, run, run_one, spec_metrics, spec_points, sweep, BgSimError};
+    #[pymodule_export]
+    use super::fit::fit;
 }

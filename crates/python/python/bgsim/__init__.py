@@ -315,6 +315,54 @@ class Model:
             raise RunError(f"{self.path}: {error}", df, stats)
         return df
 
+    def fit(
+        self,
+        data: Union[pd.DataFrame, Sequence[pd.DataFrame]],
+        params: Mapping[str, Sequence[float]],
+        outputs: Optional[Sequence[str]] = None,
+        weights: Optional[Mapping[str, float]] = None,
+        loss: str = "l2",
+        method: str = "lm",
+        t_end: Optional[float] = None,
+        rtol: Optional[float] = None,
+        inputs_interp: Optional[str] = None,
+        max_iterations: int = 50,
+    ) -> Dict[str, Any]:
+        """Fit parameters to measured data, as ``bg-sim fit`` (docs/fit.md).
+
+        ``data`` is one DataFrame or a list of them (one per experiment), each with a ``t``
+        column, columns named after ``[outputs]`` (fitted) and after ``[inputs]`` (driving
+        the run). ``params`` maps a name (``"beta"``, ``"elements.cyl1.beta"``) to
+        ``(lo, hi)`` or ``(lo, hi, start)``. Returns the report of ``bg-sim fit --format
+        json``: ``{"estimates": {name: {"value", "stderr", "ci95", "at_bound"}},
+        "correlation": {"names", "matrix"}, "cost", "iterations", "runs", "converged",
+        "warnings", "covariance": {"names", "matrix"}}``. Bad input raises
+        :class:`BgSimError` with file, line and column.
+        """
+        frames = [data] if isinstance(data, pd.DataFrame) else list(data)
+        texts = [(f"data[{k}]", df.to_csv(index=False, float_format="%.17g")) for k, df in enumerate(frames)]
+        ps = []
+        for name, b in params.items():
+            b = tuple(float(v) for v in b)
+            if len(b) not in (2, 3):
+                raise BgSimError(f"params[{name!r}]: give (lo, hi) or (lo, hi, start)")
+            ps.append((name, b[0], b[1], b[2] if len(b) == 3 else None))
+        report = _bgsim.fit(
+            self.path,
+            _overrides(self.set),
+            texts,
+            ps,
+            list(outputs) if outputs is not None else None,
+            [(k, float(v)) for k, v in (weights or {}).items()],
+            loss,
+            method,
+            t_end,
+            rtol,
+            inputs_interp,
+            max_iterations,
+        )
+        return json.loads(report)
+
     def start(
         self,
         t0: Optional[float] = None,
