@@ -41,3 +41,24 @@ def test_fit_refuses_a_column_that_is_no_output():
     with pytest.raises(bgsim.BgSimError) as e:
         bgsim.load(MODEL).fit(data=[df], params={"m": (1000.0, 4000.0)}, t_end=6.0)
     assert e.value.line == 1 and "did you mean `p_p`" in str(e.value)
+
+
+def test_a_fit_band_on_dask_matches_the_sweep(tmp_path):
+    """The fitted lift circuit's band from its covariance (docs/fit.md) on a Dask
+    LocalCluster, 20 runs of the docs' spec: the same quantiles as `bg-sim sweep` computes
+    (numpy's default quantile is the same type-7 rule)."""
+    distributed = pytest.importorskip("distributed")
+    root = MODEL.parents[1]
+    spec = tmp_path / "band.toml"
+    text = (root / "docs" / "fit" / "lift-band.toml").read_text().replace("samples = 200", "samples = 20")
+    spec.write_text(text.replace('file = "lift-fit.json"', f'file = "{root / "docs" / "fit" / "lift-fit.json"}"'))
+    with distributed.LocalCluster(n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+        band = bgsim.dask_band(client, MODEL, spec, ["p_p"])
+    # the hold after lowering: the load's pressure, (m g + A_r p_t)/A_p with m near 2160 kg
+    hold = band[(band.t > 12.0)]
+    assert np.all(hold["p_p_q05"] <= hold["p_p_mean"]) and np.all(hold["p_p_mean"] <= hold["p_p_q95"])
+    a_p, a_r = np.pi / 4 * 0.063**2, np.pi / 4 * (0.063**2 - 0.036**2)
+    expected = (2159.66 * 9.81 + a_r * 2e5) / a_p
+    assert abs(hold["p_p_mean"].mean() / expected - 1) < 2e-3
+    # the band's width there is set by the load's stderr, 0.41 kg: 2·1.645·0.41·g/A_p ≈ 4.2 kPa
+    assert 1e3 < hold["p_p_width"].mean() < 1e4
