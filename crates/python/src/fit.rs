@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use bg_model::DataFile;
-use bg_sim::fit::{self, LmOptions, Loss, Method, ParamSpec, Problem, RunOptions};
+use bg_sim::fit::{self as fitting, LmOptions, Loss, Method, ParamSpec, Problem, RunOptions};
 use pyo3::prelude::*;
 
 use super::{model_error, other_error};
@@ -45,7 +45,7 @@ pub fn fit(
             Some(s) => format!("{name}={lo:?}..{hi:?}@{s:?}"),
             None => format!("{name}={lo:?}..{hi:?}"),
         };
-        let s: ParamSpec = fit::parse_param(&arg).map_err(other_error)?;
+        let s: ParamSpec = fitting::parse_param(&arg).map_err(other_error)?;
         specs.push(s);
     }
     let mut files = Vec::new();
@@ -70,7 +70,7 @@ pub fn fit(
         ..LmOptions::default()
     };
     let result = py
-        .detach(|| fit::fit(&problem, method, &opts, &mut |_, _, _| {}))
+        .detach(|| fitting::fit(&problem, method, &opts, &mut |_, _, _| {}))
         .map_err(other_error)?;
     Ok(result.json().to_string())
 }

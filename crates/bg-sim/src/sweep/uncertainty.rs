@@ -287,6 +287,85 @@ mod tests {
         assert!(cholesky(&[vec![1.0, 1.0], vec![1.0, 1.0]]).is_none());
     }
 
+    fn column(points: &[crate::sweep::Point], j: usize) -> Vec<f64> {
+        points
+            .iter()
+            .map(|p| match p.values[j].1 {
+                crate::sweep::Value::Num(v) => v,
+                crate::sweep::Value::Text(_) => f64::NAN,
+            })
+            .collect()
+    }
+
+    fn moments(v: &[f64]) -> (f64, f64) {
+        #[allow(clippy::cast_precision_loss)]
+        let n = v.len() as f64;
+        let m = v.iter().sum::<f64>() / n;
+        (m, (v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0)).sqrt())
+    }
+
+    #[test]
+    fn distributions_are_sampled_with_their_moments() {
+        for design in ["lhs", "monte_carlo"] {
+            let text = format!(
+                "[sweep]\ndesign = \"{design}\"\nsamples = 2000\nseed = 4\n[parameters]\na = {{ dist = \"normal\", mean = 10.0, sd = 2.0 }}\nb = {{ dist = \"lognormal\", median = 5.0, sigma = 0.1 }}\nc = {{ dist = \"uniform\", from = 1.0, to = 3.0 }}\n"
+            );
+            let spec = crate::sweep::parse_spec("s.toml", &text).unwrap();
+            let p = crate::sweep::points(&spec);
+            let (m, sd) = moments(&column(&p, 0));
+            // Monte Carlo: the mean within 3 standard errors (2/√2000 = 0.045)
+            assert!((m - 10.0).abs() < 0.14 && (sd / 2.0 - 1.0).abs() < 0.05, "{design}: {m} {sd}");
+            let mut b = column(&p, 1);
+            b.sort_by(f64::total_cmp);
+            assert!((quantile(&b, 0.5) / 5.0 - 1.0).abs() < 0.01, "{design}");
+            let c = column(&p, 2);
+            assert!(c.iter().all(|v| (1.0..=3.0).contains(v)));
+        }
+        // the Latin hypercube puts one sample in each of the n probability strata
+        let spec = crate::sweep::parse_spec(
+            "s.toml",
+            "[sweep]\ndesign = \"lhs\"\nsamples = 10\n[parameters]\nc = { dist = \"uniform\", from = 0.0, to = 10.0 }\n",
+        )
+        .unwrap();
+        let mut strata: Vec<i64> = column(&crate::sweep::points(&spec), 0).iter().map(|v| {
+            #[allow(clippy::cast_possible_truncation)]
+            let s = v.floor() as i64;
+            s
+        }).collect();
+        strata.sort_unstable();
+        assert_eq!(strata, (0..10).collect::<Vec<_>>());
+        let e = crate::sweep::parse_spec("s.toml", "[parameters]\na = { dist = \"normal\", mean = 1.0, sd = 0.1 }\n").unwrap_err();
+        assert!(e.message.contains("is a distribution"), "{e}");
+        let e = crate::sweep::parse_spec("s.toml", "[sweep]\ndesign = \"lhs\"\nsamples = 3\n[parameters]\na = { dist = \"gauss\", mean = 1.0 }\n").unwrap_err();
+        assert!(e.message.contains("dist is"), "{e}");
+    }
+
+    #[test]
+    fn a_fit_is_sampled_with_its_covariance() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(
+            dir.path().join("fit.json"),
+            r#"{"estimates": {"a": {"value": 10.0}, "b": {"value": 20.0}}, "covariance": {"names": ["a", "b"], "matrix": [[4.0, 1.2], [1.2, 1.0]]}}"#,
+        )
+        .unwrap();
+        let spec_path = dir.path().join("s.toml");
+        let spec = crate::sweep::parse_spec(
+            &spec_path.display().to_string(),
+            "[sweep]\ndesign = \"lhs\"\nsamples = 4000\nseed = 2\n[parameters]\nk = [1.0]\n[from_fit]\nfile = \"fit.json\"\n",
+        )
+        .unwrap();
+        assert_eq!(spec.parameters[1].0, "parameters.a");
+        let p = crate::sweep::points(&spec);
+        let (a, b) = (column(&p, 1), column(&p, 2));
+        let ((ma, sa), (mb, sb)) = (moments(&a), moments(&b));
+        #[allow(clippy::cast_precision_loss)]
+        let cov = a.iter().zip(&b).map(|(x, y)| (x - ma) * (y - mb)).sum::<f64>() / (a.len() as f64 - 1.0);
+        assert!((ma - 10.0).abs() < 0.02 && (mb - 20.0).abs() < 0.02, "{ma} {mb}");
+        assert!((sa / 2.0 - 1.0).abs() < 0.02 && (sb - 1.0).abs() < 0.02, "{sa} {sb}");
+        // correlation 0.6 kept (its standard error is ~0.01 at n = 4000)
+        assert!((cov / (sa * sb) - 0.6).abs() < 0.04, "{}", cov / (sa * sb));
+    }
+
     #[test]
     fn band_quantiles() {
         // 101 runs of one row, values 0..100: mean 50, q05 = 5, q95 = 95
