@@ -12,6 +12,7 @@ mod commands;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use commands::sensitivity;
 use commands::{
     bench, check, compare, energy, fmu, graph, kinds, linearize, modes, plot, reduce, run, sweep,
     FAILED,
@@ -56,6 +57,10 @@ enum Command {
     /// or at time T of a run, its poles and DC gains; with --bode IN:OUT the frequency
     /// response of one pair (CSV/JSON data, a PNG figure with --plot).
     Linearize(linearize::Args),
+    /// Forward sensitivities ∂y/∂p of the [outputs] columns to chosen parameters in one run
+    /// (exact Jacobian, staggered with Radau): the time series (CSV), a ranking of normalised
+    /// sensitivities, its figure (docs/sensitivity.md).
+    Sensitivity(sensitivity::Args),
     /// Measure the speed–accuracy trade: every solver at every rtol against a reference
     /// (wall time, steps, rhs evaluations, the worst scaled error of the scored columns).
     Bench(bench::Args),
@@ -121,6 +126,7 @@ fn dispatch(command: Command) -> ExitCode {
         Command::Kinds(a) => kinds::command(&a),
         Command::Modes(a) => modes::command(&a),
         Command::Linearize(a) => linearize::command(&a),
+        Command::Sensitivity(a) => sensitivity::command(&a),
         Command::Bench(a) => bench::command(a),
         Command::Energy(a) => energy::command(&a),
         Command::Reduce(a) => reduce::command(a),

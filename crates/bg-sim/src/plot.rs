@@ -15,6 +15,7 @@ mod energy;
 mod figure;
 mod quick;
 mod results;
+mod sensitivity;
 mod work_precision;
 
 use std::path::PathBuf;
@@ -29,6 +30,7 @@ pub use energy::{energy_bars, energy_segments, Segment};
 pub use figure::{draw, draw_all};
 pub use quick::quick_look;
 pub use results::{not_a_regular_file, Results, PLOT_ROWS};
+pub use sensitivity::{sensitivity_bars, SensitivityBar};
 pub use work_precision::{work_precision, WorkPrecisionLine};
 
 /// Why the figures could not be drawn.

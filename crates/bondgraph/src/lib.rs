@@ -95,6 +95,7 @@ pub mod linearize;
 pub mod local_jacobian;
 pub mod modes;
 pub mod partials_check;
+pub mod sensitivity;
 /// The Radau IIA integrator, from the solver crate (`bg-solver`), re-exported.
 pub use bg_solver::radau;
 pub mod simulate;

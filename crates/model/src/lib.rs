@@ -63,6 +63,7 @@ pub mod plots;
 pub mod reader;
 pub mod registry;
 pub mod scene;
+pub mod sensitivity;
 pub mod steady;
 pub mod tables;
 
@@ -77,4 +78,5 @@ pub use plots::{Panel, Plot, Series};
 pub use reader::{ElementSpec, RawValue};
 pub use registry::Registry;
 pub use scene::{Choice, Scene, Switch};
+pub use sensitivity::Sensitivities;
 pub use steady::SteadyReport;

@@ -7,6 +7,7 @@
 //! pickle, so the same calls run on Dask workers. Loading costs milliseconds.
 
 mod fit;
+mod sensitivity;
 mod stepping;
 
 use std::path::{Path, PathBuf};
@@ -326,6 +327,8 @@ fn sweep<'py>(
 /// Bond-graph model files from Python (the compiled half of `bgsim`).
 #[pymodule]
 mod _bgsim {
+    #[pymodule_export]
+    use super::sensitivity::sensitivity;
     #[pymodule_export]
     use super::stepping::{linearize, start, Sim};
     #[pymodule_export]

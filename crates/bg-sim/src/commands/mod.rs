@@ -20,6 +20,7 @@ pub mod optimize;
 pub mod plot;
 pub mod reduce;
 pub mod run;
+pub mod sensitivity;
 pub mod sweep;
 
 /// Exit statuses (README, "Exit status").

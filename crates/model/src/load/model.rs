@@ -267,6 +267,33 @@ impl Model {
         Ok(out)
     }
 
+    /// The file's text as `--set` left it, and the kinds it was built with: what a twin of
+    /// the model with one value changed is built from (`crate::sensitivity`).
+    pub(crate) fn text_and_registry(&self) -> (&str, &Registry) {
+        (&self.source.text, &self.source.registry)
+    }
+
+    /// Build again, with the model's values, the entries the events replace (after a run
+    /// that did not go through [`Model::run`], `crate::sensitivity`).
+    pub(crate) fn restore_event_entries(&mut self) -> Result<(), ModelError> {
+        let touched = events::touched(&self.events);
+        if touched.is_empty() {
+            return Ok(());
+        }
+        let restore = self
+            .source
+            .rebuild(&self.equations, &self.parameters, &touched, None)?;
+        for (id, el) in restore {
+            self.equations.replace(id, el).map_err(|e| {
+                self.source
+                    .err(ErrorKind::Settings, None, e.message())
+                    .or_hint(e.hint())
+                    .with_source(e)
+            })?;
+        }
+        Ok(())
+    }
+
     /// Compare a trajectory with the model's `[[check]]`s at its output rows only (a sample:
     /// [`Model::run_into`] checks every accepted step too).
     #[must_use]

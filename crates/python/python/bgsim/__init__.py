@@ -363,6 +363,40 @@ class Model:
         )
         return json.loads(report)
 
+    def sensitivity(
+        self,
+        params: Sequence[str],
+        t_end: Optional[float] = None,
+        rtol: Optional[float] = None,
+        dt_out: Optional[float] = None,
+        inputs: Optional[InputData] = None,
+        inputs_interp: str = "linear",
+        extrapolate: Optional[str] = None,
+    ) -> pd.DataFrame:
+        """Run the model once with the forward sensitivities of its ``[outputs]`` to
+        ``params`` (``--set`` keys: ``"beta"``, ``"elements.cyl1.beta"``,
+        ``'initial."spring.q"'``; docs/sensitivity.md) and return a DataFrame: ``t``, the
+        outputs, then one column ``dy/dp`` per output and parameter. ``df.attrs`` holds the
+        parameters' ``values`` and the run's ``steps``. Other arguments as :meth:`run`."""
+        if isinstance(params, str):
+            params = [params]
+        if extrapolate not in (None, "hold"):
+            raise BgSimError(f"extrapolate={extrapolate!r}: only \"hold\" (or None) is known")
+        columns, data, info = _bgsim.sensitivity(
+            self.path,
+            _overrides(self.set),
+            list(params),
+            t_end,
+            rtol,
+            dt_out,
+            _input_data(inputs, inputs_interp),
+            extrapolate == "hold",
+        )
+        values = np.frombuffer(data, dtype=np.float64).reshape(-1, len(columns))
+        df = pd.DataFrame(values.copy(), columns=columns)
+        df.attrs.update(dict(info))
+        return df
+
     def start(
         self,
         t0: Optional[float] = None,

@@ -27,6 +27,16 @@ def run(
     extrapolate: bool = False,
     energy: bool = False,
 ) -> Tuple[List[str], bytes, Dict[str, Any], Optional[str]]: ...
+def sensitivity(
+    path: str,
+    set: List[str],
+    params: List[str],
+    t_end: Optional[float] = None,
+    rtol: Optional[float] = None,
+    dt_out: Optional[float] = None,
+    inputs: List[Any] = ...,
+    extrapolate: bool = False,
+) -> Tuple[List[str], bytes, Dict[str, Any]]: ...
 def run_one(
     path: str,
     values: Dict[str, Union[float, str]],

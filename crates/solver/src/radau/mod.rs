@@ -102,6 +102,7 @@ mod controller;
 mod error;
 mod integrator;
 mod linear;
+mod sensitivity;
 mod stages;
 mod tableau;
 
@@ -111,6 +112,7 @@ pub use crate::problem::DMatrix;
 
 use controller::Controller;
 pub use error::RadauError;
+pub use sensitivity::{Sensitivities, SensitivityRhs};
 use tableau::Tableau;
 
 pub use crate::problem::{OdeSystem, SparsePattern};
