@@ -3,8 +3,9 @@
 //! Weighted nonlinear least squares between the model's `[outputs]` and the data's columns
 //! of the same name, over bounded parameters, by a bounded Levenberg–Marquardt ([`lm`]);
 //! then how well the data fix each parameter ([`stats`]): standard errors, 95 % intervals,
-//! correlations and warnings. The derivatives come from central differences of whole runs
-//! ([`jacobian`], `--jacobian fd`); a derivative-free Nelder–Mead ([`nelder_mead`]) is the
+//! correlations and warnings. The derivatives are the core's exact forward sensitivities
+//! ([`bg_model::Model::sensitivities`], `--jacobian exact`, the default) or central
+//! differences of whole runs ([`jacobian`], `--jacobian fd`); a derivative-free Nelder–Mead ([`nelder_mead`]) is the
 //! comparison (`--method nelder-mead`) and, as a parallel particle swarm, the search of
 //! `bg-sim optimize`. The report is [`Fit::json`] (the shape tools read) or
 //! [`Fit::text`]; [`fitted_model`] writes the model file with the fitted values, comments
@@ -36,6 +37,16 @@ pub enum Method {
     Lm,
     /// Nelder–Mead on the cost, no derivatives (the comparison).
     NelderMead,
+}
+
+/// Where the Jacobian comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum JacobianKind {
+    /// The core's exact forward sensitivities: one run per experiment and iteration.
+    #[default]
+    Exact,
+    /// Central differences of whole runs: 2·P + 1 runs per experiment and iteration.
+    Fd,
 }
 
 /// A finished fit.
@@ -76,6 +87,7 @@ pub struct Fit {
 pub fn fit(
     problem: &Problem,
     method: Method,
+    jacobian_kind: JacobianKind,
     opts: &LmOptions,
     on_iteration: &mut dyn FnMut(usize, &Iteration, &[f64]),
 ) -> Result<Fit, String> {
@@ -84,7 +96,10 @@ pub fn fit(
     let hi: Vec<f64> = problem.params.iter().map(|s| s.hi).collect();
     let reg = (problem.registry)();
     let residuals = |p: &[f64]| problem.residuals(&reg, p);
-    let jac = |p: &[f64]| jacobian::residuals_and_jacobian(problem, p);
+    let jac = |p: &[f64]| match jacobian_kind {
+        JacobianKind::Exact => jacobian::exact_residuals_and_jacobian(problem, p),
+        JacobianKind::Fd => jacobian::residuals_and_jacobian(problem, p),
+    };
     let (p, history, converged, reason) = match method {
         Method::Lm => {
             let res = lm::lm(&residuals, &jac, &problem.start, &lo, &hi, opts, on_iteration)?;

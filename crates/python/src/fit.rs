@@ -70,7 +70,7 @@ pub fn fit(
         ..LmOptions::default()
     };
     let result = py
-        .detach(|| fitting::fit(&problem, method, &opts, &mut |_, _, _| {}))
+        .detach(|| fitting::fit(&problem, method, fitting::JacobianKind::Exact, &opts, &mut |_, _, _| {}))
         .map_err(other_error)?;
     Ok(result.json().to_string())
 }

@@ -37,8 +37,9 @@ pub struct Args {
     /// lm (Levenberg–Marquardt) or nelder-mead (derivative-free, for comparison).
     #[arg(long, default_value = "lm")]
     pub method: String,
-    /// How the Jacobian is formed: fd (central differences of whole runs).
-    #[arg(long, default_value = "fd")]
+    /// How the Jacobian is formed: exact (the core's forward sensitivities, one run per
+    /// iteration) or fd (central differences of whole runs, 2·P + 1 runs).
+    #[arg(long, default_value = "exact")]
     pub jacobian: String,
     /// Most iterations.
     #[arg(long, default_value_t = 50)]
@@ -103,12 +104,11 @@ pub fn command(a: Args) -> ExitCode {
         "nelder-mead" => Method::NelderMead,
         other => return refuse(format!("--method {other}: not a method\n  hint: lm or nelder-mead")),
     };
-    if a.jacobian != "fd" {
-        return refuse(format!(
-            "--jacobian {}: not available in this build\n  hint: fd (central differences of whole runs)",
-            a.jacobian
-        ));
-    }
+    let jacobian = match a.jacobian.as_str() {
+        "exact" => fit::JacobianKind::Exact,
+        "fd" => fit::JacobianKind::Fd,
+        other => return refuse(format!("--jacobian {other}: not a choice\n  hint: exact or fd")),
+    };
     let data: Vec<&std::path::Path> = a.data.iter().map(PathBuf::as_path).collect();
     let run = RunOptions {
         set: a.set.clone(),
@@ -153,7 +153,7 @@ pub fn command(a: Args) -> ExitCode {
             );
         }
     };
-    let result = match fit::fit(&problem, method, &opts, &mut progress) {
+    let result = match fit::fit(&problem, method, jacobian, &opts, &mut progress) {
         Ok(r) => r,
         Err(m) => {
             tell!("error: {}: the fit stopped: {m}", a.model.display());

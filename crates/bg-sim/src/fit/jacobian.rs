@@ -57,3 +57,52 @@ pub fn residuals_and_jacobian(problem: &Problem, p: &[f64]) -> Result<(Vec<f64>,
     }
     Ok((r0, j))
 }
+
+/// Residuals and their Jacobian at `p` from the exact forward sensitivities of the core
+/// ([`bg_model::Model::sensitivities`]: the sensitivity equations integrated alongside the
+/// run, reusing its Jacobian and LU): one run per experiment, whatever the number of
+/// parameters. The model's outputs and their derivatives are interpolated to the data's
+/// times as the residuals are.
+///
+/// # Errors
+/// A run that fails, or a parameter the sensitivities do not take.
+pub fn exact_residuals_and_jacobian(problem: &Problem, p: &[f64]) -> Result<(Vec<f64>, DMatrix<f64>), String> {
+    use std::sync::atomic::Ordering;
+    let reg = (problem.registry)();
+    let names: Vec<String> = problem.params.iter().map(|s| s.path.clone()).collect();
+    let np = p.len();
+    let mut r = Vec::with_capacity(problem.n_residuals());
+    let mut jrows: Vec<f64> = Vec::with_capacity(problem.n_residuals() * np);
+    for e in &problem.experiments {
+        let mut m = problem.model(&reg, e, p)?;
+        problem.runs.fetch_add(1, Ordering::Relaxed);
+        let s = m.sensitivities(&names).map_err(|e| e.to_string())?;
+        let no = s.outputs.len();
+        let cols: Vec<usize> = e
+            .fitted
+            .iter()
+            .map(|&(j, _)| {
+                s.outputs
+                    .iter()
+                    .position(|o| *o == problem.outputs[j])
+                    .ok_or_else(|| format!("output `{}` missing from the sensitivities", problem.outputs[j]))
+            })
+            .collect::<Result<_, _>>()?;
+        let tcol = e.data.column("t").or_else(|| e.data.column("time")).unwrap_or(0);
+        let times = &e.data.columns[tcol];
+        for &i in &e.rows {
+            let (a, b, w) = super::problem::bracket(&s.t, times[i]);
+            for (c, &(j, k)) in e.fitted.iter().enumerate() {
+                let col = cols[c];
+                let sw = problem.weights[j].sqrt();
+                let y = s.y[a * no + col] + w * (s.y[b * no + col] - s.y[a * no + col]);
+                r.push(sw * (y - e.data.columns[k][i]));
+                for kk in 0..np {
+                    let (da, db) = (s.get(a, col, kk), s.get(b, col, kk));
+                    jrows.push(sw * (da + w * (db - da)));
+                }
+            }
+        }
+    }
+    Ok((r.clone(), DMatrix::from_row_slice(r.len(), np, &jrows)))
+}

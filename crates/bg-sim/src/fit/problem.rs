@@ -542,7 +542,7 @@ fn apply_settings(m: &mut Model, run: &RunOptions) -> Result<(), String> {
 }
 
 /// Indices `a ≤ b` of the rows around time `t` and the weight of `b`.
-fn bracket(t: &[f64], x: f64) -> (usize, usize, f64) {
+pub(crate) fn bracket(t: &[f64], x: f64) -> (usize, usize, f64) {
     let n = t.len();
     if n < 2 || x <= t[0] {
         return (0, 0, 0.0);
