@@ -3,10 +3,11 @@ knuckle-boom crane at hidden values of beta, R_l, r_p and m3, with 1 % Gaussian 
 each column's RMS) on p_p1, p_r1, l1, l2 and q3; `bg-sim fit` from starts 30 % off, then the
 same by Nelder–Mead, and the product pair C_d·w. Prints each fit's report and a summary.
 
-    python3 scripts/fit-crane-recovery.py [BG_SIM] [T_END]
+    python3 scripts/fit-crane-recovery.py [BG_SIM] [T_END] [METHODS]
 
 BG_SIM defaults to target/release/bg-sim if built, else target/debug/bg-sim; T_END (s) to
-the model's 20 s. Only the standard library is used.
+the model's 20 s; METHODS to "lm,lm-fd,nelder-mead" (comma-separated; lm uses the exact
+sensitivities, lm-fd central differences). Only the standard library is used.
 """
 
 import csv
@@ -66,8 +67,10 @@ def main():
             for r in rows:
                 w.writerow([r["t"], *(repr(float(r[c]) + rng.gauss(0, sigma[c])) for c in COLUMNS)])
         params = [f"{k}={BOUNDS[k][0]!r}..{BOUNDS[k][1]!r}@{0.7 * v!r}" for k, v in HIDDEN.items()]
-        for method in ["lm", "nelder-mead"]:
-            rep, wall = fit(bg_sim, data, params, [*extra, "--method", method])
+        methods = sys.argv[3].split(",") if len(sys.argv) > 3 else ["lm", "lm-fd", "nelder-mead"]
+        for method in methods:
+            how = ["--method", "lm", "--jacobian", "fd"] if method == "lm-fd" else ["--method", method]
+            rep, wall = fit(bg_sim, data, params, [*extra, *how])
             print(f"== {method}: {rep['iterations']} iterations, {rep['runs']} runs, {wall:.1f} s, "
                   f"converged {rep['converged']}, cost {rep['cost']:.6e}")
             for k, v in HIDDEN.items():
