@@ -102,21 +102,41 @@ pub fn fit(
     };
     let (p, history, converged, reason) = match method {
         Method::Lm => {
-            let res = lm::lm(&residuals, &jac, &problem.start, &lo, &hi, opts, on_iteration)?;
+            let res = lm::lm(
+                &residuals,
+                &jac,
+                &problem.start,
+                &lo,
+                &hi,
+                opts,
+                on_iteration,
+            )?;
             (res.p, res.history, res.converged, res.reason)
         }
         Method::NelderMead => {
             let cost = |p: &[f64]| {
                 let reg = (problem.registry)();
-                problem
-                    .residuals(&reg, p)
-                    .map_or(f64::INFINITY, |r| 0.5 * r.iter().map(|v| v * v).sum::<f64>())
+                problem.residuals(&reg, p).map_or(f64::INFINITY, |r| {
+                    0.5 * r.iter().map(|v| v * v).sum::<f64>()
+                })
             };
-            let found = nelder_mead::nelder_mead(&cost, &problem.start, &lo, &hi, 1e-10, 400 * problem.params.len());
+            let found = nelder_mead::nelder_mead(
+                &cost,
+                &problem.start,
+                &lo,
+                &hi,
+                1e-10,
+                400 * problem.params.len(),
+            );
             let history = found
                 .history
                 .iter()
-                .map(|&c| Iteration { cost: c, step: 0.0, lambda: 0.0, rejected: 0 })
+                .map(|&c| Iteration {
+                    cost: c,
+                    step: 0.0,
+                    lambda: 0.0,
+                    rejected: 0,
+                })
                 .collect();
             let reason = if found.converged {
                 "the simplex's costs agree within 1e-10".to_owned()
@@ -134,7 +154,15 @@ pub fn fit(
             let mut a: Vec<f64> = r.iter().map(|v| v.abs()).collect();
             a.sort_by(f64::total_cmp);
             let c = 1.345 * 1.4826 * a.get(a.len() / 2).copied().unwrap_or(0.0);
-            r.iter().map(|v| if c > 0.0 && v.abs() > c { c / v.abs() } else { 1.0 }).collect()
+            r.iter()
+                .map(|v| {
+                    if c > 0.0 && v.abs() > c {
+                        c / v.abs()
+                    } else {
+                        1.0
+                    }
+                })
+                .collect()
         }
     };
     let cost = 0.5 * r.iter().zip(&rho).map(|(v, w)| w * v * v).sum::<f64>();
@@ -142,7 +170,11 @@ pub fn fit(
     let names: Vec<String> = problem.params.iter().map(|s| s.name.clone()).collect();
     let mut warnings = Vec::new();
     if !st.unidentifiable.is_empty() {
-        let who: Vec<&str> = st.unidentifiable.iter().map(|&k| names[k].as_str()).collect();
+        let who: Vec<&str> = st
+            .unidentifiable
+            .iter()
+            .map(|&k| names[k].as_str())
+            .collect();
         warnings.push(format!(
             "unidentifiable: the information is near-singular (smallest scaled eigenvalue {:.1e}); the data fix only a combination of {} — fix all but one of them, or add data that separate them",
             st.min_eigenvalue,
@@ -304,7 +336,12 @@ impl Fit {
 ///
 /// # Errors
 /// A path the text does not take.
-pub fn fitted_model(file: &str, text: &str, problem: &Problem, p: &[f64]) -> Result<String, String> {
+pub fn fitted_model(
+    file: &str,
+    text: &str,
+    problem: &Problem,
+    p: &[f64],
+) -> Result<String, String> {
     bg_model::overrides::apply(file, text, &problem.overrides(p)).map_err(|e| e.to_string())
 }
 
@@ -313,19 +350,36 @@ pub fn fitted_model(file: &str, text: &str, problem: &Problem, p: &[f64]) -> Res
 ///
 /// # Errors
 /// A run or the drawing fails.
-pub fn plot_fit(problem: &Problem, p: &[f64], path: &Path) -> Result<Vec<std::path::PathBuf>, String> {
+pub fn plot_fit(
+    problem: &Problem,
+    p: &[f64],
+    path: &Path,
+) -> Result<Vec<std::path::PathBuf>, String> {
     use bg_model::plots::{Panel, Plot, Series};
     let reg = (problem.registry)();
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let stem = path.file_stem().map_or_else(|| "fit".to_owned(), |s| s.to_string_lossy().into_owned());
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let stem = path
+        .file_stem()
+        .map_or_else(|| "fit".to_owned(), |s| s.to_string_lossy().into_owned());
     let mut written = Vec::new();
     for (x, e) in problem.experiments.iter().enumerate() {
         let y = problem.simulate(&reg, e, p)?;
-        let tcol = e.data.column("t").or_else(|| e.data.column("time")).unwrap_or(0);
+        let tcol = e
+            .data
+            .column("t")
+            .or_else(|| e.data.column("time"))
+            .unwrap_or(0);
         let mut head = vec!["t".to_owned()];
         for &(j, _) in &e.fitted {
             let n = &problem.outputs[j];
-            head.extend([format!("{n}_data"), format!("{n}_fit"), format!("{n}_residual")]);
+            head.extend([
+                format!("{n}_data"),
+                format!("{n}_fit"),
+                format!("{n}_residual"),
+            ]);
         }
         let mut csv = head.join(",");
         csv.push('\n');
@@ -339,7 +393,8 @@ pub fn plot_fit(problem: &Problem, p: &[f64], path: &Path) -> Result<Vec<std::pa
             }
             csv.push('\n');
         }
-        let results = crate::plot::Results::parse(&csv).map_err(|(l, m)| format!("line {l}: {m}"))?;
+        let results =
+            crate::plot::Results::parse(&csv).map_err(|(l, m)| format!("line {l}: {m}"))?;
         let series = |column: String, label: &str, dashed: bool| Series {
             column,
             label: label.to_owned(),
@@ -355,7 +410,10 @@ pub fn plot_fit(problem: &Problem, p: &[f64], path: &Path) -> Result<Vec<std::pa
                 y_label: nm.clone(),
                 unit: None,
                 x_range: None,
-                series: vec![series(format!("{nm}_data"), "measured", false), series(format!("{nm}_fit"), "fitted model", true)],
+                series: vec![
+                    series(format!("{nm}_data"), "measured", false),
+                    series(format!("{nm}_fit"), "fitted model", true),
+                ],
                 line: 0,
             });
             panels.push(Panel {
@@ -366,7 +424,11 @@ pub fn plot_fit(problem: &Problem, p: &[f64], path: &Path) -> Result<Vec<std::pa
                 line: 0,
             });
         }
-        let file = if x == 0 { stem.clone() } else { format!("{stem}-{}", x + 1) };
+        let file = if x == 0 {
+            stem.clone()
+        } else {
+            format!("{stem}-{}", x + 1)
+        };
         let plot = Plot {
             file,
             title: format!("Fit to {}", e.file),
@@ -375,7 +437,10 @@ pub fn plot_fit(problem: &Problem, p: &[f64], path: &Path) -> Result<Vec<std::pa
             panels,
             line: 0,
         };
-        written.extend(crate::plot::draw(&results, &plot, dir, crate::plot::Format::Png).map_err(|e| e.to_string())?);
+        written.extend(
+            crate::plot::draw(&results, &plot, dir, crate::plot::Format::Png)
+                .map_err(|e| e.to_string())?,
+        );
     }
     Ok(written)
 }

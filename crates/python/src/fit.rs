@@ -53,7 +53,8 @@ pub fn fit(
         files.push(DataFile::parse(text, name).map_err(|e| model_error(py, &e))?);
     }
     let file = path.display().to_string();
-    let raw = std::fs::read_to_string(&path).map_err(|e| other_error(format!("{file}: cannot read the model: {e}")))?;
+    let raw = std::fs::read_to_string(&path)
+        .map_err(|e| other_error(format!("{file}: cannot read the model: {e}")))?;
     let text = bg_model::overrides::apply(&file, &raw, &set).map_err(|e| model_error(py, &e))?;
     let run = RunOptions {
         set: Vec::new(),
@@ -61,8 +62,17 @@ pub fn fit(
         rtol,
         interp: inputs_interp,
     };
-    let mut problem = Problem::from_parts(file, text, &files, specs, outputs.as_deref(), &weights, run, bg_sim::registry)
-        .map_err(|e| model_error(py, &e))?;
+    let mut problem = Problem::from_parts(
+        file,
+        text,
+        &files,
+        specs,
+        outputs.as_deref(),
+        &weights,
+        run,
+        bg_sim::registry,
+    )
+    .map_err(|e| model_error(py, &e))?;
     problem.loss = loss;
     let opts = LmOptions {
         max_iterations,
@@ -70,7 +80,15 @@ pub fn fit(
         ..LmOptions::default()
     };
     let result = py
-        .detach(|| fitting::fit(&problem, method, fitting::JacobianKind::Exact, &opts, &mut |_, _, _| {}))
+        .detach(|| {
+            fitting::fit(
+                &problem,
+                method,
+                fitting::JacobianKind::Exact,
+                &opts,
+                &mut |_, _, _| {},
+            )
+        })
         .map_err(other_error)?;
     Ok(result.json().to_string())
 }

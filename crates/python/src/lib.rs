@@ -328,11 +328,11 @@ fn sweep<'py>(
 #[pymodule]
 mod _bgsim {
     #[pymodule_export]
+    use super::fit::fit;
+    #[pymodule_export]
     use super::sensitivity::sensitivity;
     #[pymodule_export]
     use super::stepping::{linearize, start, Sim};
     #[pymodule_export]
     use super::{describe, run, run_one, spec_metrics, spec_points, sweep, BgSimError};
-    #[pymodule_export]
-    use super::fit::fit;
 }

@@ -102,12 +102,20 @@ pub fn command(a: Args) -> ExitCode {
     let method = match a.method.as_str() {
         "lm" => Method::Lm,
         "nelder-mead" => Method::NelderMead,
-        other => return refuse(format!("--method {other}: not a method\n  hint: lm or nelder-mead")),
+        other => {
+            return refuse(format!(
+                "--method {other}: not a method\n  hint: lm or nelder-mead"
+            ))
+        }
     };
     let jacobian = match a.jacobian.as_str() {
         "exact" => fit::JacobianKind::Exact,
         "fd" => fit::JacobianKind::Fd,
-        other => return refuse(format!("--jacobian {other}: not a choice\n  hint: exact or fd")),
+        other => {
+            return refuse(format!(
+                "--jacobian {other}: not a choice\n  hint: exact or fd"
+            ))
+        }
     };
     let data: Vec<&std::path::Path> = a.data.iter().map(PathBuf::as_path).collect();
     let run = RunOptions {
@@ -116,7 +124,15 @@ pub fn command(a: Args) -> ExitCode {
         rtol: a.rtol,
         interp: a.inputs_interp.clone(),
     };
-    let mut problem = match Problem::new(&a.model, &data, params, a.outputs.as_deref(), &weights, run, registry) {
+    let mut problem = match Problem::new(
+        &a.model,
+        &data,
+        params,
+        a.outputs.as_deref(),
+        &weights,
+        run,
+        registry,
+    ) {
         Ok(p) => p,
         Err(e) => return refuse(e),
     };
@@ -142,13 +158,21 @@ pub fn command(a: Args) -> ExitCode {
     let names: Vec<String> = problem.params.iter().map(|s| s.name.clone()).collect();
     let mut progress = |k: usize, it: &fit::Iteration, p: &[f64]| {
         if !quiet {
-            let vals: Vec<String> = names.iter().zip(p).map(|(n, v)| format!("{n}={v:.6e}")).collect();
+            let vals: Vec<String> = names
+                .iter()
+                .zip(p)
+                .map(|(n, v)| format!("{n}={v:.6e}"))
+                .collect();
             tell!(
                 "iteration {k:>2}: cost {:.6e}, step {:.2e}, λ {:.1e}{}  {}",
                 it.cost,
                 it.step,
                 it.lambda,
-                if it.rejected > 0 { format!(" ({} rejected)", it.rejected) } else { String::new() },
+                if it.rejected > 0 {
+                    format!(" ({} rejected)", it.rejected)
+                } else {
+                    String::new()
+                },
                 vals.join(" ")
             );
         }

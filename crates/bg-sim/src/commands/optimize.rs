@@ -53,22 +53,55 @@ pub fn command(a: &Args) -> ExitCode {
         "{} runs in {:.1} s; {}",
         opt.runs.len(),
         opt.wall_s,
-        if opt.converged { "converged" } else { "stopped at the budget" }
+        if opt.converged {
+            "converged"
+        } else {
+            "stopped at the budget"
+        }
     );
-    say!("best ({}):", if opt.best.feasible { "every constraint holds" } else { "NO run kept every constraint" });
+    say!(
+        "best ({}):",
+        if opt.best.feasible {
+            "every constraint holds"
+        } else {
+            "NO run kept every constraint"
+        }
+    );
     for (n, v) in names.iter().zip(&opt.best.p) {
         say!("  {n} = {v:.6e}");
     }
     for (n, v) in metric_names.iter().zip(&opt.best.metrics) {
-        say!("  {n}: {}", v.map_or_else(|| "(none)".to_owned(), |v| format!("{v:.6e}")));
+        say!(
+            "  {n}: {}",
+            v.map_or_else(|| "(none)".to_owned(), |v| format!("{v:.6e}"))
+        );
     }
-    let mut code = if opt.best.feasible { ExitCode::SUCCESS } else { ExitCode::from(FAILED) };
+    let mut code = if opt.best.feasible {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(FAILED)
+    };
     if let Some(out) = &a.output {
-        let mut csv = format!("run,{},{},score,feasible\n", names.join(","), metric_names.join(","));
+        let mut csv = format!(
+            "run,{},{},score,feasible\n",
+            names.join(","),
+            metric_names.join(",")
+        );
         for (i, r) in opt.runs.iter().enumerate() {
             let p: Vec<String> = r.p.iter().map(|v| format!("{v:?}")).collect();
-            let m: Vec<String> = r.metrics.iter().map(|v| v.map_or_else(String::new, |v| format!("{v:?}"))).collect();
-            csv.push_str(&format!("{},{},{},{:?},{}\n", i + 1, p.join(","), m.join(","), r.score, r.feasible));
+            let m: Vec<String> = r
+                .metrics
+                .iter()
+                .map(|v| v.map_or_else(String::new, |v| format!("{v:?}")))
+                .collect();
+            csv.push_str(&format!(
+                "{},{},{},{:?},{}\n",
+                i + 1,
+                p.join(","),
+                m.join(","),
+                r.score,
+                r.feasible
+            ));
         }
         if let Err(e) = std::fs::write(out, csv) {
             tell!("error: cannot write {}: {e}", out.display());
@@ -76,7 +109,11 @@ pub fn command(a: &Args) -> ExitCode {
         }
     }
     if let Some(png) = &a.plot {
-        if let Err(e) = history_plot(&opt.history, &metric_names[spec.objective.0.min(metric_names.len().saturating_sub(1))], png) {
+        if let Err(e) = history_plot(
+            &opt.history,
+            &metric_names[spec.objective.0.min(metric_names.len().saturating_sub(1))],
+            png,
+        ) {
             tell!("error: cannot draw {}: {e}", png.display());
             code = ExitCode::from(FAILED);
         }
@@ -96,7 +133,9 @@ fn history_plot(history: &[f64], objective: &str, png: &std::path::Path) -> Resu
     }
     let results = bg_sim::plot::Results::parse(&csv).map_err(|(l, m)| format!("line {l}: {m}"))?;
     let plot = Plot {
-        file: png.file_stem().map_or_else(|| "history".into(), |s| s.to_string_lossy().into_owned()),
+        file: png
+            .file_stem()
+            .map_or_else(|| "history".into(), |s| s.to_string_lossy().into_owned()),
         title: format!("Optimisation history: best {objective} (feasible runs)"),
         x: "t".into(),
         x_label: "generation".into(),
@@ -104,11 +143,23 @@ fn history_plot(history: &[f64], objective: &str, png: &std::path::Path) -> Resu
             y_label: objective.to_owned(),
             unit: None,
             x_range: None,
-            series: vec![Series { column: "best".into(), label: "best so far".into(), scale: 1.0, offset: 0.0, dashed: false, line: 0 }],
+            series: vec![Series {
+                column: "best".into(),
+                label: "best so far".into(),
+                scale: 1.0,
+                offset: 0.0,
+                dashed: false,
+                line: 0,
+            }],
             line: 0,
         }],
         line: 0,
     };
-    let dir = png.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
-    bg_sim::plot::draw(&results, &plot, dir, bg_sim::plot::Format::Png).map(drop).map_err(|e| e.to_string())
+    let dir = png
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    bg_sim::plot::draw(&results, &plot, dir, bg_sim::plot::Format::Png)
+        .map(drop)
+        .map_err(|e| e.to_string())
 }

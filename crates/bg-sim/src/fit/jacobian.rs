@@ -27,7 +27,10 @@ pub fn step(problem: &Problem, k: usize, v: f64) -> f64 {
 ///
 /// # Errors
 /// A run that fails.
-pub fn residuals_and_jacobian(problem: &Problem, p: &[f64]) -> Result<(Vec<f64>, DMatrix<f64>), String> {
+pub fn residuals_and_jacobian(
+    problem: &Problem,
+    p: &[f64],
+) -> Result<(Vec<f64>, DMatrix<f64>), String> {
     let np = p.len();
     // job 0: the centre; job 2k+1: +h_k; job 2k+2: −h_k
     let jobs: Vec<Vec<f64>> = std::iter::once(p.to_vec())
@@ -66,7 +69,10 @@ pub fn residuals_and_jacobian(problem: &Problem, p: &[f64]) -> Result<(Vec<f64>,
 ///
 /// # Errors
 /// A run that fails, or a parameter the sensitivities do not take.
-pub fn exact_residuals_and_jacobian(problem: &Problem, p: &[f64]) -> Result<(Vec<f64>, DMatrix<f64>), String> {
+pub fn exact_residuals_and_jacobian(
+    problem: &Problem,
+    p: &[f64],
+) -> Result<(Vec<f64>, DMatrix<f64>), String> {
     use std::sync::atomic::Ordering;
     let reg = (problem.registry)();
     let names: Vec<String> = problem.params.iter().map(|s| s.path.clone()).collect();
@@ -85,10 +91,19 @@ pub fn exact_residuals_and_jacobian(problem: &Problem, p: &[f64]) -> Result<(Vec
                 s.outputs
                     .iter()
                     .position(|o| *o == problem.outputs[j])
-                    .ok_or_else(|| format!("output `{}` missing from the sensitivities", problem.outputs[j]))
+                    .ok_or_else(|| {
+                        format!(
+                            "output `{}` missing from the sensitivities",
+                            problem.outputs[j]
+                        )
+                    })
             })
             .collect::<Result<_, _>>()?;
-        let tcol = e.data.column("t").or_else(|| e.data.column("time")).unwrap_or(0);
+        let tcol = e
+            .data
+            .column("t")
+            .or_else(|| e.data.column("time"))
+            .unwrap_or(0);
         let times = &e.data.columns[tcol];
         for &i in &e.rows {
             let (a, b, w) = super::problem::bracket(&s.t, times[i]);

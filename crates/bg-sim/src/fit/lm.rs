@@ -85,7 +85,13 @@ fn loss_weights(loss: Loss, r: &[f64]) -> Vec<f64> {
             let med = a.get(a.len() / 2).copied().unwrap_or(0.0);
             let c = 1.345 * 1.4826 * med;
             r.iter()
-                .map(|v| if c > 0.0 && v.abs() > c { c / v.abs() } else { 1.0 })
+                .map(|v| {
+                    if c > 0.0 && v.abs() > c {
+                        c / v.abs()
+                    } else {
+                        1.0
+                    }
+                })
                 .collect()
         }
     }
@@ -112,7 +118,11 @@ pub fn lm(
     on_iteration: &mut dyn FnMut(usize, &Iteration, &[f64]),
 ) -> Result<LmResult, String> {
     let np = p0.len();
-    let mut p: Vec<f64> = p0.iter().zip(lo.iter().zip(hi)).map(|(v, (l, h))| v.clamp(*l, *h)).collect();
+    let mut p: Vec<f64> = p0
+        .iter()
+        .zip(lo.iter().zip(hi))
+        .map(|(v, (l, h))| v.clamp(*l, *h))
+        .collect();
     let (mut r, mut j) = jacobian(&p)?;
     let mut rho = loss_weights(opts.loss, &r);
     let mut cost = cost_of(&r, &rho);
@@ -152,7 +162,10 @@ pub fn lm(
             reason = "every parameter is held at a bound".into();
             break;
         }
-        let gnorm = free.iter().map(|&k| (g[k] * (p[k].abs().max(width(k) * 1e-6))).abs()).fold(0.0, f64::max);
+        let gnorm = free
+            .iter()
+            .map(|&k| (g[k] * (p[k].abs().max(width(k) * 1e-6))).abs())
+            .fold(0.0, f64::max);
         if gnorm <= 1e-12 * cost.max(f64::MIN_POSITIVE) {
             converged = true;
             reason = "the gradient vanishes".into();
@@ -170,7 +183,11 @@ pub fn lm(
                 }
                 m[(x, x)] += lambda * a[(k, k)].max(1e-30);
             }
-            let delta = m.clone().cholesky().map(|c| c.solve(&b)).or_else(|| m.lu().solve(&b));
+            let delta = m
+                .clone()
+                .cholesky()
+                .map(|c| c.solve(&b))
+                .or_else(|| m.lu().solve(&b));
             let Some(delta) = delta else {
                 lambda *= nu;
                 nu *= 2.0;
@@ -187,8 +204,12 @@ pub fn lm(
             }
             let d: DVector<f64> = DVector::from_iterator(np, (0..np).map(|k| trial[k] - p[k]));
             let predicted = -(g.dot(&d) + 0.5 * d.dot(&(&a * &d)));
-            let step = (0..np).map(|k| d[k].abs() / p[k].abs().max(1e-300)).fold(0.0, f64::max);
-            let tried = residuals(&trial).ok().filter(|rt| rt.iter().all(|v| v.is_finite()));
+            let step = (0..np)
+                .map(|k| d[k].abs() / p[k].abs().max(1e-300))
+                .fold(0.0, f64::max);
+            let tried = residuals(&trial)
+                .ok()
+                .filter(|rt| rt.iter().all(|v| v.is_finite()));
             let (ratio, rt) = match tried {
                 Some(rt) if predicted > 0.0 => ((cost - cost_of(&rt, &rho)) / predicted, Some(rt)),
                 _ => (-1.0, None),
@@ -204,7 +225,12 @@ pub fn lm(
                 cost = cost_of(&r, &rho);
                 lambda *= f64::max(1.0 / 3.0, 1.0 - (2.0 * ratio - 1.0).powi(3));
                 nu = 2.0;
-                let iter = Iteration { cost, step, lambda, rejected };
+                let iter = Iteration {
+                    cost,
+                    step,
+                    lambda,
+                    rejected,
+                };
                 on_iteration(it + 1, &iter, &p);
                 history.push(iter);
                 if (old - cost).abs() <= opts.ftol * old {
@@ -256,7 +282,10 @@ mod tests {
         vec![10.0 * (p[1] - p[0] * p[0]), 1.0 - p[0]]
     }
     fn rosen_j(p: &[f64]) -> (Vec<f64>, DMatrix<f64>) {
-        (rosen(p), DMatrix::from_row_slice(2, 2, &[-20.0 * p[0], 10.0, -1.0, 0.0]))
+        (
+            rosen(p),
+            DMatrix::from_row_slice(2, 2, &[-20.0 * p[0], 10.0, -1.0, 0.0]),
+        )
     }
 
     #[test]
@@ -271,7 +300,11 @@ mod tests {
             &mut |_, _, _| {},
         )
         .unwrap();
-        assert!((res.p[0] - 1.0).abs() < 1e-6 && (res.p[1] - 1.0).abs() < 1e-6, "{:?}", res.p);
+        assert!(
+            (res.p[0] - 1.0).abs() < 1e-6 && (res.p[1] - 1.0).abs() < 1e-6,
+            "{:?}",
+            res.p
+        );
         assert!(res.converged, "{}", res.reason);
         assert!(res.history.len() < 30, "{}", res.history.len());
     }

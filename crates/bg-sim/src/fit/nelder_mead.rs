@@ -21,7 +21,10 @@ pub struct Found {
 }
 
 fn to_p(u: &[f64], lo: &[f64], hi: &[f64]) -> Vec<f64> {
-    u.iter().zip(lo.iter().zip(hi)).map(|(u, (l, h))| l + u.clamp(0.0, 1.0) * (h - l)).collect()
+    u.iter()
+        .zip(lo.iter().zip(hi))
+        .map(|(u, (l, h))| l + u.clamp(0.0, 1.0) * (h - l))
+        .collect()
 }
 
 /// Nelder–Mead (standard coefficients 1, 2, ½, ½) from `p0`, the first simplex 10 % of the
@@ -36,15 +39,27 @@ pub fn nelder_mead(
     max_evaluations: usize,
 ) -> Found {
     let n = p0.len();
-    let u0: Vec<f64> = p0.iter().zip(lo.iter().zip(hi)).map(|(p, (l, h))| (p - l) / (h - l)).collect();
+    let u0: Vec<f64> = p0
+        .iter()
+        .zip(lo.iter().zip(hi))
+        .map(|(p, (l, h))| (p - l) / (h - l))
+        .collect();
     let eval = |u: &[f64]| {
         let v = f(&to_p(u, lo, hi));
-        if v.is_finite() { v } else { f64::INFINITY }
+        if v.is_finite() {
+            v
+        } else {
+            f64::INFINITY
+        }
     };
     let mut simplex: Vec<Vec<f64>> = vec![u0.clone()];
     for k in 0..n {
         let mut u = u0.clone();
-        u[k] = if u[k] + 0.1 <= 1.0 { u[k] + 0.1 } else { u[k] - 0.1 };
+        u[k] = if u[k] + 0.1 <= 1.0 {
+            u[k] + 0.1
+        } else {
+            u[k] - 0.1
+        };
         simplex.push(u);
     }
     let mut values: Vec<f64> = simplex.par_iter().map(|u| eval(u)).collect();
@@ -62,9 +77,15 @@ pub fn nelder_mead(
             break;
         }
         #[allow(clippy::cast_precision_loss)]
-        let centroid: Vec<f64> = (0..n).map(|k| simplex[..n].iter().map(|u| u[k]).sum::<f64>() / n as f64).collect();
+        let centroid: Vec<f64> = (0..n)
+            .map(|k| simplex[..n].iter().map(|u| u[k]).sum::<f64>() / n as f64)
+            .collect();
         let along = |t: f64| -> Vec<f64> {
-            centroid.iter().zip(&simplex[n]).map(|(c, w)| (c + t * (c - w)).clamp(0.0, 1.0)).collect()
+            centroid
+                .iter()
+                .zip(&simplex[n])
+                .map(|(c, w)| (c + t * (c - w)).clamp(0.0, 1.0))
+                .collect()
         };
         let xr = along(1.0);
         let fr = eval(&xr);
@@ -84,7 +105,11 @@ pub fn nelder_mead(
             simplex[n] = xr;
             values[n] = fr;
         } else {
-            let xc = if fr < values[n] { along(0.5) } else { along(-0.5) };
+            let xc = if fr < values[n] {
+                along(0.5)
+            } else {
+                along(-0.5)
+            };
             let fc = eval(&xc);
             evaluations += 1;
             if fc < values[n].min(fr) {
@@ -95,7 +120,12 @@ pub fn nelder_mead(
                 let best = simplex[0].clone();
                 let shrunk: Vec<Vec<f64>> = simplex[1..]
                     .iter()
-                    .map(|u| u.iter().zip(&best).map(|(x, b)| b + 0.5 * (x - b)).collect())
+                    .map(|u| {
+                        u.iter()
+                            .zip(&best)
+                            .map(|(x, b)| b + 0.5 * (x - b))
+                            .collect()
+                    })
                     .collect();
                 let fs: Vec<f64> = shrunk.par_iter().map(|u| eval(u)).collect();
                 evaluations += n;
@@ -106,7 +136,9 @@ pub fn nelder_mead(
             }
         }
     }
-    let best = (0..=n).min_by(|&a, &b| values[a].total_cmp(&values[b])).unwrap_or(0);
+    let best = (0..=n)
+        .min_by(|&a, &b| values[a].total_cmp(&values[b]))
+        .unwrap_or(0);
     Found {
         p: to_p(&simplex[best], lo, hi),
         f: values[best],
@@ -151,16 +183,28 @@ pub fn particle_swarm(
 ) -> Found {
     let n = lo.len();
     let mut rng = SplitMix(seed);
-    let mut x: Vec<Vec<f64>> = (0..particles).map(|_| (0..n).map(|_| rng.unit()).collect()).collect();
+    let mut x: Vec<Vec<f64>> = (0..particles)
+        .map(|_| (0..n).map(|_| rng.unit()).collect())
+        .collect();
     if let (Some(p0), Some(first)) = (p0, x.first_mut()) {
-        *first = p0.iter().zip(lo.iter().zip(hi)).map(|(p, (l, h))| ((p - l) / (h - l)).clamp(0.0, 1.0)).collect();
+        *first = p0
+            .iter()
+            .zip(lo.iter().zip(hi))
+            .map(|(p, (l, h))| ((p - l) / (h - l)).clamp(0.0, 1.0))
+            .collect();
     }
-    let mut v: Vec<Vec<f64>> = (0..particles).map(|_| (0..n).map(|_| 0.2 * (rng.unit() - 0.5)).collect()).collect();
+    let mut v: Vec<Vec<f64>> = (0..particles)
+        .map(|_| (0..n).map(|_| 0.2 * (rng.unit() - 0.5)).collect())
+        .collect();
     let eval_all = |x: &[Vec<f64>]| -> Vec<f64> {
         x.par_iter()
             .map(|u| {
                 let y = f(&to_p(u, lo, hi));
-                if y.is_finite() { y } else { f64::INFINITY }
+                if y.is_finite() {
+                    y
+                } else {
+                    f64::INFINITY
+                }
             })
             .collect()
     };
@@ -168,7 +212,9 @@ pub fn particle_swarm(
     let mut evaluations = particles;
     let mut best_x = x.clone();
     let mut best_f = fx.clone();
-    let mut g = (0..particles).min_by(|&a, &b| fx[a].total_cmp(&fx[b])).unwrap_or(0);
+    let mut g = (0..particles)
+        .min_by(|&a, &b| fx[a].total_cmp(&fx[b]))
+        .unwrap_or(0);
     let mut history = vec![best_f[g]];
     let mut stale = 0;
     let mut converged = false;
@@ -191,7 +237,9 @@ pub fn particle_swarm(
                 best_x[i].clone_from(&x[i]);
             }
         }
-        g = (0..particles).min_by(|&a, &b| best_f[a].total_cmp(&best_f[b])).unwrap_or(0);
+        g = (0..particles)
+            .min_by(|&a, &b| best_f[a].total_cmp(&best_f[b]))
+            .unwrap_or(0);
         history.push(best_f[g]);
         if before - best_f[g] <= ftol * before.abs().max(1e-300) {
             stale += 1;
@@ -222,8 +270,19 @@ mod tests {
 
     #[test]
     fn nelder_mead_finds_the_rosenbrock_minimum() {
-        let r = nelder_mead(&rosen, &[-1.2, 1.0], &[-2.0, -2.0], &[2.0, 2.0], 1e-14, 5000);
-        assert!((r.p[0] - 1.0).abs() < 1e-3 && (r.p[1] - 1.0).abs() < 2e-3, "{:?}", r.p);
+        let r = nelder_mead(
+            &rosen,
+            &[-1.2, 1.0],
+            &[-2.0, -2.0],
+            &[2.0, 2.0],
+            1e-14,
+            5000,
+        );
+        assert!(
+            (r.p[0] - 1.0).abs() < 1e-3 && (r.p[1] - 1.0).abs() < 2e-3,
+            "{:?}",
+            r.p
+        );
         assert!(r.converged);
     }
 
@@ -232,7 +291,11 @@ mod tests {
         // (x − 3)² + (y + 1)² in [0, 2] × [−2, 2]: the minimum at the bound x = 2, y = −1
         let f = |p: &[f64]| (p[0] - 3.0).powi(2) + (p[1] + 1.0).powi(2);
         let a = particle_swarm(&f, None, &[0.0, -2.0], &[2.0, 2.0], 16, 200, 1e-12, 7);
-        assert!((a.p[0] - 2.0).abs() < 1e-4 && (a.p[1] + 1.0).abs() < 1e-3, "{:?}", a.p);
+        assert!(
+            (a.p[0] - 2.0).abs() < 1e-4 && (a.p[1] + 1.0).abs() < 1e-3,
+            "{:?}",
+            a.p
+        );
         let b = particle_swarm(&f, None, &[0.0, -2.0], &[2.0, 2.0], 16, 200, 1e-12, 7);
         assert_eq!(a.p, b.p);
     }

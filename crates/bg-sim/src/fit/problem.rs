@@ -32,7 +32,8 @@ pub struct ParamSpec {
 /// # Errors
 /// The argument's form, or bounds reversed or excluding the start, as a message with a hint.
 pub fn parse_param(arg: &str) -> Result<ParamSpec, String> {
-    let form = "\n  hint: --param NAME=LO..HI or NAME=LO..HI@START, e.g. --param beta=1e9..2e9@1.2e9";
+    let form =
+        "\n  hint: --param NAME=LO..HI or NAME=LO..HI@START, e.g. --param beta=1e9..2e9@1.2e9";
     let (name, rest) = arg
         .split_once('=')
         .ok_or_else(|| format!("--param `{arg}`: expected NAME=LO..HI[@START]{form}"))?;
@@ -46,7 +47,12 @@ pub fn parse_param(arg: &str) -> Result<ParamSpec, String> {
             .parse::<f64>()
             .ok()
             .filter(|v| v.is_finite())
-            .ok_or_else(|| format!("--param `{arg}`: {what} `{}` is not a finite number{form}", s.trim()))
+            .ok_or_else(|| {
+                format!(
+                    "--param `{arg}`: {what} `{}` is not a finite number{form}",
+                    s.trim()
+                )
+            })
     };
     let (lo, hi) = range
         .split_once("..")
@@ -206,9 +212,8 @@ impl Problem {
         registry: fn() -> Registry,
     ) -> Result<Self, ModelError> {
         let file = model_path.display().to_string();
-        let raw = std::fs::read_to_string(model_path).map_err(|e| {
-            merr(ErrorKind::Io, &file, format!("cannot read the model: {e}"))
-        })?;
+        let raw = std::fs::read_to_string(model_path)
+            .map_err(|e| merr(ErrorKind::Io, &file, format!("cannot read the model: {e}")))?;
         let text = bg_model::overrides::apply(&file, &raw, &run.set)?;
         let mut data_files = Vec::new();
         for d in data {
@@ -217,7 +222,16 @@ impl Problem {
             df.times()?;
             data_files.push(df);
         }
-        Self::from_parts(file, text, &data_files, params, outputs, weights, run, registry)
+        Self::from_parts(
+            file,
+            text,
+            &data_files,
+            params,
+            outputs,
+            weights,
+            run,
+            registry,
+        )
     }
 
     /// As [`Problem::new`] with the model's text (after `--set`) and the data read.
@@ -249,8 +263,12 @@ impl Problem {
         let interp = match run.interp.as_deref() {
             None => Interp::Linear,
             Some(s) => Interp::parse(s).ok_or_else(|| {
-                merr(ErrorKind::Settings, &file, format!("--inputs-interp {s}: not an interpolation"))
-                    .hint("linear or hold")
+                merr(
+                    ErrorKind::Settings,
+                    &file,
+                    format!("--inputs-interp {s}: not an interpolation"),
+                )
+                .hint("linear or hold")
             })?,
         };
         if data.is_empty() {
@@ -258,15 +276,21 @@ impl Problem {
                 .hint("--data measured.csv with a `t` column and columns named after the model's [outputs]"));
         }
         if params.is_empty() {
-            return Err(merr(ErrorKind::Override, &file, "no --param: nothing to fit")
-                .hint("--param NAME=LO..HI[@START]"));
+            return Err(
+                merr(ErrorKind::Override, &file, "no --param: nothing to fit")
+                    .hint("--param NAME=LO..HI[@START]"),
+            );
         }
         // the parameters: each must exist; the start is the model's value unless given
         let names: Vec<&str> = model.parameters.keys().map(String::as_str).collect();
         let mut start = Vec::new();
         for (k, p) in params.iter().enumerate() {
             if params[..k].iter().any(|q| q.path == p.path) {
-                return Err(merr(ErrorKind::Override, &file, format!("--param `{}` is given twice", p.name)));
+                return Err(merr(
+                    ErrorKind::Override,
+                    &file,
+                    format!("--param `{}` is given twice", p.name),
+                ));
             }
             let value = if let Some(bare) = p.path.strip_prefix("parameters.") {
                 let Some(v) = model.parameters.get(bare) else {
@@ -286,10 +310,18 @@ impl Problem {
                 number_at(&text, &p.path)
             };
             // the path must take a value (an element parameter that exists)
-            bg_model::overrides::apply(&file, &text, &[format!("{}=1.0", p.path)]).map_err(|e| {
-                merr(ErrorKind::Override, &file, format!("--param `{}`: {}", p.name, e.message))
-                    .hint(e.hint.clone().unwrap_or_else(|| "name a [parameters] entry or elements.NAME.PARAM".into()))
-            })?;
+            bg_model::overrides::apply(&file, &text, &[format!("{}=1.0", p.path)]).map_err(
+                |e| {
+                    merr(
+                        ErrorKind::Override,
+                        &file,
+                        format!("--param `{}`: {}", p.name, e.message),
+                    )
+                    .hint(e.hint.clone().unwrap_or_else(|| {
+                        "name a [parameters] entry or elements.NAME.PARAM".into()
+                    }))
+                },
+            )?;
             let s = match (p.start, value) {
                 (Some(s), _) => s,
                 (None, Some(v)) if v >= p.lo && v <= p.hi => v,
@@ -297,26 +329,40 @@ impl Problem {
                     return Err(merr(
                         ErrorKind::Override,
                         &file,
-                        format!("--param `{}`: the model's value {v} is outside the bounds {}..{}", p.name, p.lo, p.hi),
+                        format!(
+                            "--param `{}`: the model's value {v} is outside the bounds {}..{}",
+                            p.name, p.lo, p.hi
+                        ),
                     )
-                    .hint(format!("give a start inside them: {}={}..{}@START", p.name, p.lo, p.hi)))
+                    .hint(format!(
+                        "give a start inside them: {}={}..{}@START",
+                        p.name, p.lo, p.hi
+                    )))
                 }
                 (None, None) => {
                     return Err(merr(
                         ErrorKind::Override,
                         &file,
-                        format!("--param `{}`: the model's value is not a plain number", p.name),
+                        format!(
+                            "--param `{}`: the model's value is not a plain number",
+                            p.name
+                        ),
                     )
-                    .hint(format!("give the start: {}={}..{}@START", p.name, p.lo, p.hi)))
+                    .hint(format!(
+                        "give the start: {}={}..{}@START",
+                        p.name, p.lo, p.hi
+                    )))
                 }
             };
             // and the model must build with it (an element's parameter that its kind has)
             if !p.path.starts_with("parameters.") {
-                Model::from_text(&file, &text, &reg, &[format!("{}={s:?}", p.path)]).map_err(|e| {
-                    let mut e = e;
-                    e.message = format!("--param `{}`: {}", p.name, e.message);
-                    e
-                })?;
+                Model::from_text(&file, &text, &reg, &[format!("{}={s:?}", p.path)]).map_err(
+                    |e| {
+                        let mut e = e;
+                        e.message = format!("--param `{}`: {}", p.name, e.message);
+                        e
+                    },
+                )?;
             }
             start.push(s);
         }
@@ -326,8 +372,16 @@ impl Problem {
         if let Some(w) = &wanted {
             for o in w {
                 if !model_outputs.contains(o) {
-                    return Err(merr(ErrorKind::Override, &file, format!("--outputs: `{o}` is not an output of the model"))
-                        .hint(suggestion(o, &model_outputs, "the model's [outputs]")));
+                    return Err(merr(
+                        ErrorKind::Override,
+                        &file,
+                        format!("--outputs: `{o}` is not an output of the model"),
+                    )
+                    .hint(suggestion(
+                        o,
+                        &model_outputs,
+                        "the model's [outputs]",
+                    )));
                 }
             }
         }
@@ -357,23 +411,39 @@ impl Problem {
                 } else if model_inputs.contains(name) {
                     inputs.push((name.clone(), k));
                 } else {
-                    let all: Vec<String> = model_outputs.iter().chain(&model_inputs).cloned().collect();
-                    return Err(bad(&df.file, format!("column `{name}` matches no output or input of the model"))
-                        .at_cell(1, df.starts[k])
-                        .hint(suggestion(name, &all, "the model's [outputs] and [inputs]")));
+                    let all: Vec<String> =
+                        model_outputs.iter().chain(&model_inputs).cloned().collect();
+                    return Err(bad(
+                        &df.file,
+                        format!("column `{name}` matches no output or input of the model"),
+                    )
+                    .at_cell(1, df.starts[k])
+                    .hint(suggestion(
+                        name,
+                        &all,
+                        "the model's [outputs] and [inputs]",
+                    )));
                 }
             }
             if fitted.is_empty() {
                 return Err(bad(&df.file, "has no column named after a fitted output")
                     .at_cell(1, 1)
-                    .hint(format!("name columns after the model's [outputs]: {}", model_outputs.join(", "))));
+                    .hint(format!(
+                        "name columns after the model's [outputs]: {}",
+                        model_outputs.join(", ")
+                    )));
             }
             // the run must lie within the data (inputs are needed all along; outputs are
             // compared where the data are)
-            df.covers(t_start, t_end, "the data")
-                .map_err(|e| e.hint(format!("data from t = {t_start} to {t_end} s are needed; shorten the run with --t-end")))?;
+            df.covers(t_start, t_end, "the data").map_err(|e| {
+                e.hint(format!(
+                    "data from t = {t_start} to {t_end} s are needed; shorten the run with --t-end"
+                ))
+            })?;
             let tol = 1e-10 * (1.0 + t_end.abs());
-            let rows: Vec<usize> = (0..t.len()).filter(|&i| t[i] >= t_start - tol && t[i] <= t_end + tol).collect();
+            let rows: Vec<usize> = (0..t.len())
+                .filter(|&i| t[i] >= t_start - tol && t[i] <= t_end + tol)
+                .collect();
             experiments.push(Experiment {
                 file: df.file.clone(),
                 data: df.clone(),
@@ -385,8 +455,12 @@ impl Problem {
         // weights: given, else 1/scale² of the data column (its range, or |mean| if larger)
         for (o, _) in weights {
             if !fitted_names.contains(o) {
-                return Err(merr(ErrorKind::Override, &file, format!("--weights: `{o}` is not a fitted output"))
-                    .hint(suggestion(o, &fitted_names, "the fitted outputs")));
+                return Err(merr(
+                    ErrorKind::Override,
+                    &file,
+                    format!("--weights: `{o}` is not a fitted output"),
+                )
+                .hint(suggestion(o, &fitted_names, "the fitted outputs")));
             }
         }
         let weights: Vec<f64> = fitted_names
@@ -395,7 +469,8 @@ impl Problem {
             .map(|(j, n)| {
                 weights.iter().find(|(o, _)| o == n).map_or_else(
                     || {
-                        let (mut lo, mut hi, mut sum, mut count) = (f64::INFINITY, f64::NEG_INFINITY, 0.0, 0.0);
+                        let (mut lo, mut hi, mut sum, mut count) =
+                            (f64::INFINITY, f64::NEG_INFINITY, 0.0, 0.0);
                         for e in &experiments {
                             for &(jj, k) in &e.fitted {
                                 if jj == j {
@@ -440,7 +515,10 @@ impl Problem {
     /// Number of residuals.
     #[must_use]
     pub fn n_residuals(&self) -> usize {
-        self.experiments.iter().map(|e| e.rows.len() * e.fitted.len()).sum()
+        self.experiments
+            .iter()
+            .map(|e| e.rows.len() * e.fitted.len())
+            .sum()
     }
 
     /// The `--set` overrides of parameter values `p`.
@@ -458,12 +536,15 @@ impl Problem {
     /// # Errors
     /// The model does not build at these values, or the data do not drive it.
     pub fn model(&self, reg: &Registry, e: &Experiment, p: &[f64]) -> Result<Model, String> {
-        let mut m = Model::from_text(&self.file, &self.text, reg, &self.overrides(p)).map_err(|e| e.to_string())?;
+        let mut m = Model::from_text(&self.file, &self.text, reg, &self.overrides(p))
+            .map_err(|e| e.to_string())?;
         apply_settings(&mut m, &self.run)?;
         for (name, k) in &e.inputs {
             let s = e.data.series(*k, self.interp).map_err(|e| e.to_string())?;
             let i = m.equations.input_index(name).map_err(|e| e.message())?;
-            m.equations.set_input_series(i, s).map_err(|e| e.message())?;
+            m.equations
+                .set_input_series(i, s)
+                .map_err(|e| e.message())?;
         }
         Ok(m)
     }
@@ -483,10 +564,20 @@ impl Problem {
         let cols: Vec<usize> = e
             .fitted
             .iter()
-            .map(|&(j, _)| out.trajectory.columns.iter().position(|c| *c == self.outputs[j]).unwrap_or(0))
+            .map(|&(j, _)| {
+                out.trajectory
+                    .columns
+                    .iter()
+                    .position(|c| *c == self.outputs[j])
+                    .unwrap_or(0)
+            })
             .collect();
         let t: Vec<f64> = out.trajectory.rows.iter().map(|r| r[0]).collect();
-        let times = &e.data.columns[e.data.column("t").or_else(|| e.data.column("time")).unwrap_or(0)];
+        let times = &e.data.columns[e
+            .data
+            .column("t")
+            .or_else(|| e.data.column("time"))
+            .unwrap_or(0)];
         let mut y = Vec::with_capacity(e.rows.len() * cols.len());
         for &i in &e.rows {
             let (a, b, w) = bracket(&t, times[i]);
@@ -565,11 +656,13 @@ fn number_at(text: &str, path: &str) -> Option<f64> {
     for seg in path.split('.') {
         item = item.get(seg)?;
     }
-    item.as_float().or_else(|| item.as_integer().map(|i| {
-        #[allow(clippy::cast_precision_loss)]
-        let f = i as f64;
-        f
-    }))
+    item.as_float().or_else(|| {
+        item.as_integer().map(|i| {
+            #[allow(clippy::cast_precision_loss)]
+            let f = i as f64;
+            f
+        })
+    })
 }
 
 fn suggestion(name: &str, names: &[String], what: &str) -> String {
@@ -587,11 +680,18 @@ mod tests {
     #[test]
     fn param_arguments_are_read_and_checked() {
         let p = parse_param("beta=1e9..2e9@1.2e9").unwrap();
-        assert_eq!((p.path.as_str(), p.lo, p.hi, p.start), ("parameters.beta", 1e9, 2e9, Some(1.2e9)));
+        assert_eq!(
+            (p.path.as_str(), p.lo, p.hi, p.start),
+            ("parameters.beta", 1e9, 2e9, Some(1.2e9))
+        );
         let p = parse_param("elements.cyl1.beta=1..2").unwrap();
         assert_eq!((p.path.as_str(), p.start), ("elements.cyl1.beta", None));
-        assert!(parse_param("beta=2e9..1e9").unwrap_err().contains("reversed"));
-        assert!(parse_param("beta=1..2@3").unwrap_err().contains("outside the bounds"));
+        assert!(parse_param("beta=2e9..1e9")
+            .unwrap_err()
+            .contains("reversed"));
+        assert!(parse_param("beta=1..2@3")
+            .unwrap_err()
+            .contains("outside the bounds"));
         assert!(parse_param("beta=1,2").unwrap_err().contains("LO..HI"));
         assert!(parse_param("beta").unwrap_err().contains("expected"));
     }

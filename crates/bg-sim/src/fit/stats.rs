@@ -93,7 +93,13 @@ pub fn stats(p: &[f64], r: &[f64], rho: &[f64], j: &DMatrix<f64>) -> Stats {
     for k in 0..np {
         for l in 0..np {
             let s = d[k] * d[l];
-            scaled[(k, l)] = if s > 0.0 { info[(k, l)] / s } else if k == l { 0.0 } else { 0.0 };
+            scaled[(k, l)] = if s > 0.0 {
+                info[(k, l)] / s
+            } else if k == l {
+                0.0
+            } else {
+                0.0
+            };
         }
     }
     let eig = scaled.clone().symmetric_eigen();
@@ -105,7 +111,9 @@ pub fn stats(p: &[f64], r: &[f64], rho: &[f64], j: &DMatrix<f64>) -> Stats {
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .unwrap_or((0, 0.0));
     let unidentifiable: Vec<usize> = if min_eigenvalue < SINGULAR {
-        (0..np).filter(|&k| eig.eigenvectors[(k, imin)].abs() > 0.3).collect()
+        (0..np)
+            .filter(|&k| eig.eigenvectors[(k, imin)].abs() > 0.3)
+            .collect()
     } else {
         Vec::new()
     };
@@ -114,7 +122,11 @@ pub fn stats(p: &[f64], r: &[f64], rho: &[f64], j: &DMatrix<f64>) -> Stats {
     let mut cov = DMatrix::<f64>::zeros(np, np);
     let top = eig.eigenvalues.iter().copied().fold(0.0, f64::max);
     for (m, &lam) in eig.eigenvalues.iter().enumerate() {
-        let inv = if lam > 1e-14 * top { 1.0 / lam } else { f64::INFINITY };
+        let inv = if lam > 1e-14 * top {
+            1.0 / lam
+        } else {
+            f64::INFINITY
+        };
         for k in 0..np {
             for l in 0..np {
                 let v = eig.eigenvectors[(k, m)] * eig.eigenvectors[(l, m)];
@@ -127,12 +139,20 @@ pub fn stats(p: &[f64], r: &[f64], rho: &[f64], j: &DMatrix<f64>) -> Stats {
     for k in 0..np {
         for l in 0..np {
             let s = d[k] * d[l];
-            cov[(k, l)] = if s > 0.0 { variance * cov[(k, l)] / s } else { f64::INFINITY };
+            cov[(k, l)] = if s > 0.0 {
+                variance * cov[(k, l)] / s
+            } else {
+                f64::INFINITY
+            };
         }
     }
     let stderr: Vec<f64> = (0..np).map(|k| cov[(k, k)].abs().sqrt()).collect();
     let t = t975(dof);
-    let ci95 = p.iter().zip(&stderr).map(|(v, s)| (v - t * s, v + t * s)).collect();
+    let ci95 = p
+        .iter()
+        .zip(&stderr)
+        .map(|(v, s)| (v - t * s, v + t * s))
+        .collect();
     let mut correlation = DMatrix::<f64>::identity(np, np);
     let mut correlated = Vec::new();
     for k in 0..np {
@@ -169,7 +189,15 @@ mod tests {
     #[test]
     fn t_quantiles_match_the_table() {
         // t₀.₉₇₅: 2.571 (5), 2.228 (10), 2.201 (11), 2.086 (20), 2.042 (30), 1.984 (100)
-        for (dof, t) in [(5, 2.571), (10, 2.228), (11, 2.201), (20, 2.086), (30, 2.042), (100, 1.984), (1_000_000, 1.960)] {
+        for (dof, t) in [
+            (5, 2.571),
+            (10, 2.228),
+            (11, 2.201),
+            (20, 2.086),
+            (30, 2.042),
+            (100, 1.984),
+            (1_000_000, 1.960),
+        ] {
             assert!((t975(dof) - t).abs() < 2e-3, "{dof}: {} vs {t}", t975(dof));
         }
     }
@@ -180,7 +208,9 @@ mod tests {
         // s²/Sxx, var(a) = s² (1/n + x̄²/Sxx)
         let n = 10;
         let x: Vec<f64> = (0..n).map(f64::from).collect();
-        let r: Vec<f64> = (0..n).map(|i| if i % 2 == 0 { 1.0 } else { -1.0 }).collect();
+        let r: Vec<f64> = (0..n)
+            .map(|i| if i % 2 == 0 { 1.0 } else { -1.0 })
+            .collect();
         let mut j = DMatrix::zeros(10, 2);
         for i in 0..10 {
             j[(i, 0)] = 1.0;
@@ -193,7 +223,11 @@ mod tests {
         assert!((s.stderr[1] - (s2 / sxx).sqrt()).abs() < 1e-12);
         assert!((s.stderr[0] - (s2 * (0.1 + 4.5 * 4.5 / sxx)).sqrt()).abs() < 1e-12);
         let corr = -4.5 / (sxx / 10.0 + 4.5 * 4.5).sqrt();
-        assert!((s.correlation[(0, 1)] - corr).abs() < 1e-12, "{}", s.correlation);
+        assert!(
+            (s.correlation[(0, 1)] - corr).abs() < 1e-12,
+            "{}",
+            s.correlation
+        );
         assert!(s.unidentifiable.is_empty());
     }
 

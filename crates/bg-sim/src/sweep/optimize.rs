@@ -93,11 +93,23 @@ fn num(v: &toml::Value) -> Option<f64> {
 /// What is wrong, with the key.
 #[allow(clippy::too_many_lines)]
 pub fn parse_opt_spec(file: &str, text: &str) -> Result<OptSpec, SweepError> {
-    let table: toml::Table = text
-        .parse()
-        .map_err(|e: toml::de::Error| err(file, format!("not a valid TOML optimisation spec: {}", e.message())))?;
+    let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
+        err(
+            file,
+            format!("not a valid TOML optimisation spec: {}", e.message()),
+        )
+    })?;
     for k in table.keys() {
-        if !["set", "optimize", "parameters", "metrics", "objective", "constraints"].contains(&k.as_str()) {
+        if ![
+            "set",
+            "optimize",
+            "parameters",
+            "metrics",
+            "objective",
+            "constraints",
+        ]
+        .contains(&k.as_str())
+        {
             return Err(err(
                 file,
                 format!("unknown section `{k}`; an optimisation spec has [set], [optimize], [parameters], [metrics], [objective] and [constraints]"),
@@ -114,19 +126,30 @@ pub fn parse_opt_spec(file: &str, text: &str) -> Result<OptSpec, SweepError> {
     let o = sub("optimize")?;
     for k in o.keys() {
         if !["method", "particles", "generations", "seed"].contains(&k.as_str()) {
-            return Err(err(file, format!("[optimize] has no key `{k}`; keys: method, particles, generations, seed")));
+            return Err(err(
+                file,
+                format!("[optimize] has no key `{k}`; keys: method, particles, generations, seed"),
+            ));
         }
     }
     let search = match o.get("method").map(toml::Value::as_str) {
         None | Some(Some("swarm")) => Search::Swarm,
         Some(Some("nelder-mead")) => Search::NelderMead,
-        _ => return Err(err(file, "[optimize] method is \"swarm\" or \"nelder-mead\"")),
+        _ => {
+            return Err(err(
+                file,
+                "[optimize] method is \"swarm\" or \"nelder-mead\"",
+            ))
+        }
     };
     let count = |k: &str, default: usize| -> Result<usize, SweepError> {
         match o.get(k) {
             None => Ok(default),
             Some(toml::Value::Integer(i)) if *i >= 1 => Ok(usize::try_from(*i).unwrap_or(default)),
-            Some(_) => Err(err(file, format!("[optimize] {k} must be a whole number ≥ 1"))),
+            Some(_) => Err(err(
+                file,
+                format!("[optimize] {k} must be a whole number ≥ 1"),
+            )),
         }
     };
     let particles = count("particles", 12)?;
@@ -134,23 +157,50 @@ pub fn parse_opt_spec(file: &str, text: &str) -> Result<OptSpec, SweepError> {
     let seed = count("seed", 1)? as u64;
     let mut parameters = Vec::new();
     for (name, v) in &sub("parameters")? {
-        let path = if name.contains('.') { name.clone() } else { format!("parameters.{name}") };
-        let t = v.as_table().ok_or_else(|| err(file, format!("parameter `{name}`: write {{ from = LO, to = HI }}")))?;
+        let path = if name.contains('.') {
+            name.clone()
+        } else {
+            format!("parameters.{name}")
+        };
+        let t = v.as_table().ok_or_else(|| {
+            err(
+                file,
+                format!("parameter `{name}`: write {{ from = LO, to = HI }}"),
+            )
+        })?;
         for k in t.keys() {
             if !["from", "to", "start"].contains(&k.as_str()) {
-                return Err(err(file, format!("parameter `{name}`: keys are from, to and start, not `{k}`")));
+                return Err(err(
+                    file,
+                    format!("parameter `{name}`: keys are from, to and start, not `{k}`"),
+                ));
             }
         }
         let (Some(lo), Some(hi)) = (t.get("from").and_then(num), t.get("to").and_then(num)) else {
-            return Err(err(file, format!("parameter `{name}`: from and to must be finite numbers")));
+            return Err(err(
+                file,
+                format!("parameter `{name}`: from and to must be finite numbers"),
+            ));
         };
         if lo >= hi {
-            return Err(err(file, format!("parameter `{name}`: from {lo} ≥ to {hi} (bounds reversed or empty)")));
+            return Err(err(
+                file,
+                format!("parameter `{name}`: from {lo} ≥ to {hi} (bounds reversed or empty)"),
+            ));
         }
-        let start = t.get("start").map(|s| num(s).ok_or_else(|| err(file, format!("parameter `{name}`: start must be a number")))).transpose()?;
+        let start = t
+            .get("start")
+            .map(|s| {
+                num(s)
+                    .ok_or_else(|| err(file, format!("parameter `{name}`: start must be a number")))
+            })
+            .transpose()?;
         if let Some(s) = start {
             if s < lo || s > hi {
-                return Err(err(file, format!("parameter `{name}`: start {s} is outside {lo}..{hi}")));
+                return Err(err(
+                    file,
+                    format!("parameter `{name}`: start {s} is outside {lo}..{hi}"),
+                ));
             }
         }
         parameters.push((path, lo, hi, start));
@@ -160,29 +210,62 @@ pub fn parse_opt_spec(file: &str, text: &str) -> Result<OptSpec, SweepError> {
     }
     let mut metrics = Vec::new();
     for (name, v) in &sub("metrics")? {
-        let src = v.as_str().ok_or_else(|| err(file, format!("metric `{name}` must be a string such as \"max(x)\"")))?;
+        let src = v.as_str().ok_or_else(|| {
+            err(
+                file,
+                format!("metric `{name}` must be a string such as \"max(x)\""),
+            )
+        })?;
         metrics.push(parse_metric(name, src).map_err(|m| err(file, m))?);
     }
     let index = |n: &str| -> Result<usize, SweepError> {
         metrics.iter().position(|m| m.name == n).ok_or_else(|| {
             let names: Vec<&str> = metrics.iter().map(|m| m.name.as_str()).collect();
-            err(file, format!("`{n}` is not a metric of [metrics] ({})", names.join(", ")))
+            err(
+                file,
+                format!("`{n}` is not a metric of [metrics] ({})", names.join(", ")),
+            )
         })
     };
     let obj = sub("objective")?;
-    let objective = match (obj.get("minimize").and_then(toml::Value::as_str), obj.get("maximize").and_then(toml::Value::as_str), obj.len()) {
+    let objective = match (
+        obj.get("minimize").and_then(toml::Value::as_str),
+        obj.get("maximize").and_then(toml::Value::as_str),
+        obj.len(),
+    ) {
         (Some(n), None, 1) => (index(n)?, 1.0),
         (None, Some(n), 1) => (index(n)?, -1.0),
-        _ => return Err(err(file, "[objective] is one of minimize = \"METRIC\" or maximize = \"METRIC\"")),
+        _ => {
+            return Err(err(
+                file,
+                "[objective] is one of minimize = \"METRIC\" or maximize = \"METRIC\"",
+            ))
+        }
     };
     let mut constraints = Vec::new();
     for (name, v) in &sub("constraints")? {
         let metric = index(name)?;
-        let t = v.as_table().ok_or_else(|| err(file, format!("constraint `{name}`: write {{ max = V }}, {{ min = V }} or both")))?;
-        let get = |k: &str| t.get(k).map(|x| num(x).ok_or_else(|| err(file, format!("constraint `{name}`: {k} must be a number")))).transpose();
+        let t = v.as_table().ok_or_else(|| {
+            err(
+                file,
+                format!("constraint `{name}`: write {{ max = V }}, {{ min = V }} or both"),
+            )
+        })?;
+        let get = |k: &str| {
+            t.get(k)
+                .map(|x| {
+                    num(x).ok_or_else(|| {
+                        err(file, format!("constraint `{name}`: {k} must be a number"))
+                    })
+                })
+                .transpose()
+        };
         let (min, max) = (get("min")?, get("max")?);
         if min.is_none() && max.is_none() || t.keys().any(|k| k != "min" && k != "max") {
-            return Err(err(file, format!("constraint `{name}`: keys are min and max")));
+            return Err(err(
+                file,
+                format!("constraint `{name}`: keys are min and max"),
+            ));
         }
         constraints.push(Constraint { metric, min, max });
     }
@@ -275,8 +358,12 @@ pub fn optimize(
     spec: &OptSpec,
 ) -> Result<Optimum, SweepError> {
     for (path, lo, _, _) in &spec.parameters {
-        bg_model::overrides::apply(file, text, &[format!("{path}={lo:?}")])
-            .map_err(|e| err(file, format!("the parameter `{path}` is not in the model: {e}")))?;
+        bg_model::overrides::apply(file, text, &[format!("{path}={lo:?}")]).map_err(|e| {
+            err(
+                file,
+                format!("the parameter `{path}` is not in the model: {e}"),
+            )
+        })?;
     }
     let started = Instant::now();
     let log = std::sync::Mutex::new(Vec::<Evaluated>::new());
@@ -284,7 +371,12 @@ pub fn optimize(
         let reg = registry();
         let point = Point {
             index: 0,
-            values: spec.parameters.iter().zip(p).map(|((k, ..), v)| (k.clone(), Value::Num(*v))).collect(),
+            values: spec
+                .parameters
+                .iter()
+                .zip(p)
+                .map(|((k, ..), v)| (k.clone(), Value::Num(*v)))
+                .collect(),
         };
         let row = run_point(file, text, &reg, &point, &spec.metrics, None, None);
         let metrics = if matches!(row.status, Status::Ok | Status::CheckFailed) {
@@ -294,19 +386,46 @@ pub fn optimize(
         };
         let (s, feasible) = score(spec, &metrics);
         if let Ok(mut l) = log.lock() {
-            l.push(Evaluated { p: p.to_vec(), metrics, score: s, feasible });
+            l.push(Evaluated {
+                p: p.to_vec(),
+                metrics,
+                score: s,
+                feasible,
+            });
         }
         s
     };
     let lo: Vec<f64> = spec.parameters.iter().map(|p| p.1).collect();
     let hi: Vec<f64> = spec.parameters.iter().map(|p| p.2).collect();
-    let start: Vec<f64> = spec.parameters.iter().map(|p| p.3.unwrap_or(0.5 * (p.1 + p.2))).collect();
+    let start: Vec<f64> = spec
+        .parameters
+        .iter()
+        .map(|p| p.3.unwrap_or(0.5 * (p.1 + p.2)))
+        .collect();
     let has_start = spec.parameters.iter().any(|p| p.3.is_some());
     let found: Found = match spec.search {
-        Search::Swarm => particle_swarm(&f, has_start.then_some(start.as_slice()), &lo, &hi, spec.particles, spec.generations, 1e-6, spec.seed),
-        Search::NelderMead => nelder_mead(&f, &start, &lo, &hi, 1e-8, spec.generations * spec.particles),
+        Search::Swarm => particle_swarm(
+            &f,
+            has_start.then_some(start.as_slice()),
+            &lo,
+            &hi,
+            spec.particles,
+            spec.generations,
+            1e-6,
+            spec.seed,
+        ),
+        Search::NelderMead => nelder_mead(
+            &f,
+            &start,
+            &lo,
+            &hi,
+            1e-8,
+            spec.generations * spec.particles,
+        ),
     };
-    let runs = log.into_inner().map_err(|_| err(file, "a worker panicked"))?;
+    let runs = log
+        .into_inner()
+        .map_err(|_| err(file, "a worker panicked"))?;
     let best = runs
         .iter()
         .min_by(|a, b| a.score.total_cmp(&b.score))
@@ -325,36 +444,57 @@ pub fn optimize(
 /// (a design variable of the optimisation's own, such as cylinder 1's bore), with a
 /// placeholder value that `--set` then replaces.
 fn with_new_parameters(text: &str, set: &[String]) -> Result<String, String> {
-    let mut doc: toml_edit::DocumentMut = text.parse().map_err(|e: toml_edit::TomlError| e.to_string())?;
-    let Some(params) = doc.get_mut("parameters").and_then(toml_edit::Item::as_table_mut) else {
+    let mut doc: toml_edit::DocumentMut = text
+        .parse()
+        .map_err(|e: toml_edit::TomlError| e.to_string())?;
+    let Some(params) = doc
+        .get_mut("parameters")
+        .and_then(toml_edit::Item::as_table_mut)
+    else {
         return Ok(text.to_owned());
     };
     let mut added = false;
     for o in set {
-        if let Some((name, _)) = o.split_once('=').and_then(|(k, v)| k.trim().strip_prefix("parameters.").map(|n| (n, v))) {
+        if let Some((name, _)) = o
+            .split_once('=')
+            .and_then(|(k, v)| k.trim().strip_prefix("parameters.").map(|n| (n, v)))
+        {
             if !name.contains('.') && !params.contains_key(name) {
                 params.insert(name, toml_edit::value(0.0));
                 added = true;
             }
         }
     }
-    Ok(if added { doc.to_string() } else { text.to_owned() })
+    Ok(if added {
+        doc.to_string()
+    } else {
+        text.to_owned()
+    })
 }
 
 /// Read the spec and model and [`optimize`].
 ///
 /// # Errors
 /// The files, the spec, or a parameter path.
-pub fn optimize_files(model: &Path, spec_path: &Path, registry: fn() -> Registry) -> Result<(OptSpec, Optimum), SweepError> {
+pub fn optimize_files(
+    model: &Path,
+    spec_path: &Path,
+    registry: fn() -> Registry,
+) -> Result<(OptSpec, Optimum), SweepError> {
     let sf = spec_path.display().to_string();
-    let spec_text = std::fs::read_to_string(spec_path).map_err(|e| err(&sf, format!("cannot read the spec: {e}")))?;
+    let spec_text = std::fs::read_to_string(spec_path)
+        .map_err(|e| err(&sf, format!("cannot read the spec: {e}")))?;
     let spec = parse_opt_spec(&sf, &spec_text)?;
     let file = model.display().to_string();
     bg_model::Model::load(model, &registry(), &[]).map_err(|e| err(&file, e.to_string()))?;
-    let text = std::fs::read_to_string(model).map_err(|e| err(&file, format!("cannot read the model: {e}")))?;
-    let text = with_new_parameters(&text, &spec.set).map_err(|m| err(&sf, format!("[set]: {m}")))?;
-    let text = bg_model::overrides::apply(&file, &text, &spec.set).map_err(|e| err(&sf, format!("[set]: {e}")))?;
-    bg_model::Model::from_text(&file, &text, &registry(), &[]).map_err(|e| err(&sf, format!("the model with [set]: {e}")))?;
+    let text = std::fs::read_to_string(model)
+        .map_err(|e| err(&file, format!("cannot read the model: {e}")))?;
+    let text =
+        with_new_parameters(&text, &spec.set).map_err(|m| err(&sf, format!("[set]: {m}")))?;
+    let text = bg_model::overrides::apply(&file, &text, &spec.set)
+        .map_err(|e| err(&sf, format!("[set]: {e}")))?;
+    bg_model::Model::from_text(&file, &text, &registry(), &[])
+        .map_err(|e| err(&sf, format!("the model with [set]: {e}")))?;
     let opt = optimize(&file, &text, registry, &spec)?;
     Ok((spec, opt))
 }

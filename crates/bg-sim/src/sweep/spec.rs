@@ -294,15 +294,28 @@ fn parse(file: &str, text: &str) -> Result<Spec, (At, SweepError)> {
     let from_fit = match table.get("from_fit") {
         None => None,
         Some(toml::Value::Table(t)) => {
-            let Some(f) = t.get("file").and_then(toml::Value::as_str).filter(|_| t.len() == 1) else {
-                return Err(nowhere(err(file, "[from_fit] has one key, file = \"FIT.json\"")));
+            let Some(f) = t
+                .get("file")
+                .and_then(toml::Value::as_str)
+                .filter(|_| t.len() == 1)
+            else {
+                return Err(nowhere(err(
+                    file,
+                    "[from_fit] has one key, file = \"FIT.json\"",
+                )));
             };
             // relative to the spec
-            let path = std::path::Path::new(file).parent().unwrap_or(std::path::Path::new("")).join(f);
+            let path = std::path::Path::new(file)
+                .parent()
+                .unwrap_or(std::path::Path::new(""))
+                .join(f);
             let ff = FromFit::read(&path, file).map_err(nowhere)?;
             for (k, p) in ff.paths.iter().enumerate() {
                 if parameters.iter().any(|(q, _)| q == p) {
-                    return Err(nowhere(err(file, format!("`{p}` is both in [parameters] and in the fit of [from_fit]"))));
+                    return Err(nowhere(err(
+                        file,
+                        format!("`{p}` is both in [parameters] and in the fit of [from_fit]"),
+                    )));
                 }
                 parameters.push((p.clone(), Values::Dist(Dist::FromFit(k))));
             }
@@ -312,17 +325,31 @@ fn parse(file: &str, text: &str) -> Result<Spec, (At, SweepError)> {
     };
     let band = match table.get("band") {
         None => Vec::new(),
-        Some(toml::Value::Table(t)) => match (t.get("columns").and_then(toml::Value::as_array), t.len()) {
-            (Some(a), 1) if !a.is_empty() => a
-                .iter()
-                .map(|c| c.as_str().map(str::to_owned).ok_or_else(|| nowhere(err(file, "[band] columns are names of output columns"))))
-                .collect::<Result<_, _>>()?,
-            _ => return Err(nowhere(err(file, "[band] has one key, columns = [\"y1\", …]"))),
-        },
+        Some(toml::Value::Table(t)) => {
+            match (t.get("columns").and_then(toml::Value::as_array), t.len()) {
+                (Some(a), 1) if !a.is_empty() => a
+                    .iter()
+                    .map(|c| {
+                        c.as_str().map(str::to_owned).ok_or_else(|| {
+                            nowhere(err(file, "[band] columns are names of output columns"))
+                        })
+                    })
+                    .collect::<Result<_, _>>()?,
+                _ => {
+                    return Err(nowhere(err(
+                        file,
+                        "[band] has one key, columns = [\"y1\", …]",
+                    )))
+                }
+            }
+        }
         Some(_) => return Err(nowhere(err(file, "`band` must be a table"))),
     };
     if design == Design::Grid {
-        if let Some((k, _)) = parameters.iter().find(|(_, v)| matches!(v, Values::Dist(_))) {
+        if let Some((k, _)) = parameters
+            .iter()
+            .find(|(_, v)| matches!(v, Values::Dist(_)))
+        {
             return Err(nowhere(err(
                 file,
                 format!("`{k}` is a distribution: sample it with design = \"lhs\" or \"monte_carlo\" (samples = N, seed = S)"),
@@ -410,7 +437,9 @@ fn parse_values(file: &str, name: &str, v: &toml::Value) -> Result<Values, Sweep
             a.iter().map(scalar).collect::<Result<_, _>>()?,
         )),
         toml::Value::Array(_) => Err(err(file, format!("`{name}`: the list is empty"))),
-        toml::Value::Table(t) if t.contains_key("dist") => Ok(Values::Dist(parse_dist(name, t, file)?)),
+        toml::Value::Table(t) if t.contains_key("dist") => {
+            Ok(Values::Dist(parse_dist(name, t, file)?))
+        }
         toml::Value::Table(t) => {
             for k in t.keys() {
                 if !["from", "to", "n", "scale"].contains(&k.as_str()) {

@@ -90,19 +90,34 @@ impl FromFit {
     /// unidentifiable parameter: fix it before sampling).
     pub fn read(path: &Path, spec_file: &str) -> Result<Self, SweepError> {
         let shown = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| err(spec_file, format!("[from_fit] cannot read {shown}: {e}")))?;
-        let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| err(&shown, format!("not JSON: {e}")))?;
-        let bad = |m: &str| err(&shown, format!("{m}\n  hint: write it with `bg-sim fit … --format json > {shown}`"));
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| err(spec_file, format!("[from_fit] cannot read {shown}: {e}")))?;
+        let v: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| err(&shown, format!("not JSON: {e}")))?;
+        let bad = |m: &str| {
+            err(
+                &shown,
+                format!("{m}\n  hint: write it with `bg-sim fit … --format json > {shown}`"),
+            )
+        };
         let names: Vec<String> = v["covariance"]["names"]
             .as_array()
             .ok_or_else(|| bad("has no covariance.names"))?
             .iter()
-            .map(|n| n.as_str().map(str::to_owned).ok_or_else(|| bad("covariance.names holds a non-string")))
+            .map(|n| {
+                n.as_str()
+                    .map(str::to_owned)
+                    .ok_or_else(|| bad("covariance.names holds a non-string"))
+            })
             .collect::<Result<_, _>>()?;
         let n = names.len();
         let mut mean = Vec::with_capacity(n);
         for name in &names {
-            mean.push(v["estimates"][name]["value"].as_f64().ok_or_else(|| bad(&format!("no estimates.{name}.value")))?);
+            mean.push(
+                v["estimates"][name]["value"]
+                    .as_f64()
+                    .ok_or_else(|| bad(&format!("no estimates.{name}.value")))?,
+            );
         }
         let mut c = vec![vec![0.0; n]; n];
         for (k, row) in c.iter_mut().enumerate() {
@@ -117,7 +132,13 @@ impl FromFit {
         })?;
         let paths = names
             .iter()
-            .map(|n| if n.contains('.') { n.clone() } else { format!("parameters.{n}") })
+            .map(|n| {
+                if n.contains('.') {
+                    n.clone()
+                } else {
+                    format!("parameters.{n}")
+                }
+            })
             .collect();
         Ok(Self { paths, mean, chol })
     }
@@ -162,12 +183,24 @@ pub fn parse_dist(name: &str, t: &toml::Table, file: &str) -> Result<Dist, Sweep
             Some(toml::Value::Float(f)) if f.is_finite() => Ok(*f),
             #[allow(clippy::cast_precision_loss)]
             Some(toml::Value::Integer(i)) => Ok(*i as f64),
-            _ => Err(err(file, format!("`{name}`: `{k}` must be a finite number"))),
+            _ => Err(err(
+                file,
+                format!("`{name}`: `{k}` must be a finite number"),
+            )),
         }
     };
     let keys = |allowed: &[&str]| -> Result<(), SweepError> {
-        match t.keys().find(|k| k.as_str() != "dist" && !allowed.contains(&k.as_str())) {
-            Some(k) => Err(err(file, format!("`{name}`: this distribution has {}, not `{k}`", allowed.join(" and ")))),
+        match t
+            .keys()
+            .find(|k| k.as_str() != "dist" && !allowed.contains(&k.as_str()))
+        {
+            Some(k) => Err(err(
+                file,
+                format!(
+                    "`{name}`: this distribution has {}, not `{k}`",
+                    allowed.join(" and ")
+                ),
+            )),
             None => Ok(()),
         }
     };
@@ -207,12 +240,40 @@ pub fn parse_dist(name: &str, t: &toml::Table, file: &str) -> Result<Dist, Sweep
 /// below 1.2e-9), for u in (0, 1).
 #[must_use]
 pub fn normal_quantile(u: f64) -> f64 {
-    const A: [f64; 6] = [-3.969_683_028_665_376e1, 2.209_460_984_245_205e2, -2.759_285_104_469_687e2, 1.383_577_518_672_69e2, -3.066_479_806_614_716e1, 2.506_628_277_459_239];
-    const B: [f64; 5] = [-5.447_609_879_822_406e1, 1.615_858_368_580_409e2, -1.556_989_798_598_866e2, 6.680_131_188_771_972e1, -1.328_068_155_288_572e1];
-    const C: [f64; 6] = [-7.784_894_002_430_293e-3, -3.223_964_580_411_365e-1, -2.400_758_277_161_838, -2.549_732_539_343_734, 4.374_664_141_464_968, 2.938_163_982_698_783];
-    const D: [f64; 4] = [7.784_695_709_041_462e-3, 3.224_671_290_700_398e-1, 2.445_134_137_142_996, 3.754_408_661_907_416];
+    const A: [f64; 6] = [
+        -3.969_683_028_665_376e1,
+        2.209_460_984_245_205e2,
+        -2.759_285_104_469_687e2,
+        1.383_577_518_672_69e2,
+        -3.066_479_806_614_716e1,
+        2.506_628_277_459_239,
+    ];
+    const B: [f64; 5] = [
+        -5.447_609_879_822_406e1,
+        1.615_858_368_580_409e2,
+        -1.556_989_798_598_866e2,
+        6.680_131_188_771_972e1,
+        -1.328_068_155_288_572e1,
+    ];
+    const C: [f64; 6] = [
+        -7.784_894_002_430_293e-3,
+        -3.223_964_580_411_365e-1,
+        -2.400_758_277_161_838,
+        -2.549_732_539_343_734,
+        4.374_664_141_464_968,
+        2.938_163_982_698_783,
+    ];
+    const D: [f64; 4] = [
+        7.784_695_709_041_462e-3,
+        3.224_671_290_700_398e-1,
+        2.445_134_137_142_996,
+        3.754_408_661_907_416,
+    ];
     let u = u.clamp(1e-300, 1.0 - 1e-16);
-    let tail = |q: f64| (((((C[0] * q + C[1]) * q + C[2]) * q + C[3]) * q + C[4]) * q + C[5]) / ((((D[0] * q + D[1]) * q + D[2]) * q + D[3]) * q + 1.0);
+    let tail = |q: f64| {
+        (((((C[0] * q + C[1]) * q + C[2]) * q + C[3]) * q + C[4]) * q + C[5])
+            / ((((D[0] * q + D[1]) * q + D[2]) * q + D[3]) * q + 1.0)
+    };
     if u < 0.02425 {
         tail((-2.0 * u.ln()).sqrt())
     } else if u > 1.0 - 0.02425 {
@@ -235,7 +296,11 @@ pub fn band(runs: &[Vec<Vec<f64>>], cols: usize) -> Vec<Vec<(f64, f64, f64)>> {
         .map(|i| {
             (0..cols)
                 .map(|j| {
-                    let mut v: Vec<f64> = runs.iter().filter_map(|r| r.get(i).map(|row| row[j])).filter(|x| x.is_finite()).collect();
+                    let mut v: Vec<f64> = runs
+                        .iter()
+                        .filter_map(|r| r.get(i).map(|row| row[j]))
+                        .filter(|x| x.is_finite())
+                        .collect();
                     v.sort_by(f64::total_cmp);
                     #[allow(clippy::cast_precision_loss)]
                     let mean = v.iter().sum::<f64>() / v.len().max(1) as f64;
@@ -269,8 +334,17 @@ mod tests {
 
     #[test]
     fn normal_quantiles_are_right() {
-        for (u, z) in [(0.5, 0.0), (0.975, 1.959_963_984_540_054), (0.05, -1.644_853_626_951_472_2), (0.001, -3.090_232_306_167_813_5)] {
-            assert!((normal_quantile(u) - z).abs() < 1e-8, "{u}: {}", normal_quantile(u));
+        for (u, z) in [
+            (0.5, 0.0),
+            (0.975, 1.959_963_984_540_054),
+            (0.05, -1.644_853_626_951_472_2),
+            (0.001, -3.090_232_306_167_813_5),
+        ] {
+            assert!(
+                (normal_quantile(u) - z).abs() < 1e-8,
+                "{u}: {}",
+                normal_quantile(u)
+            );
         }
     }
 
@@ -301,7 +375,10 @@ mod tests {
         #[allow(clippy::cast_precision_loss)]
         let n = v.len() as f64;
         let m = v.iter().sum::<f64>() / n;
-        (m, (v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0)).sqrt())
+        (
+            m,
+            (v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0)).sqrt(),
+        )
     }
 
     #[test]
@@ -314,7 +391,10 @@ mod tests {
             let p = crate::sweep::points(&spec);
             let (m, sd) = moments(&column(&p, 0));
             // Monte Carlo: the mean within 3 standard errors (2/√2000 = 0.045)
-            assert!((m - 10.0).abs() < 0.14 && (sd / 2.0 - 1.0).abs() < 0.05, "{design}: {m} {sd}");
+            assert!(
+                (m - 10.0).abs() < 0.14 && (sd / 2.0 - 1.0).abs() < 0.05,
+                "{design}: {m} {sd}"
+            );
             let mut b = column(&p, 1);
             b.sort_by(f64::total_cmp);
             assert!((quantile(&b, 0.5) / 5.0 - 1.0).abs() < 0.01, "{design}");
@@ -327,14 +407,21 @@ mod tests {
             "[sweep]\ndesign = \"lhs\"\nsamples = 10\n[parameters]\nc = { dist = \"uniform\", from = 0.0, to = 10.0 }\n",
         )
         .unwrap();
-        let mut strata: Vec<i64> = column(&crate::sweep::points(&spec), 0).iter().map(|v| {
-            #[allow(clippy::cast_possible_truncation)]
-            let s = v.floor() as i64;
-            s
-        }).collect();
+        let mut strata: Vec<i64> = column(&crate::sweep::points(&spec), 0)
+            .iter()
+            .map(|v| {
+                #[allow(clippy::cast_possible_truncation)]
+                let s = v.floor() as i64;
+                s
+            })
+            .collect();
         strata.sort_unstable();
         assert_eq!(strata, (0..10).collect::<Vec<_>>());
-        let e = crate::sweep::parse_spec("s.toml", "[parameters]\na = { dist = \"normal\", mean = 1.0, sd = 0.1 }\n").unwrap_err();
+        let e = crate::sweep::parse_spec(
+            "s.toml",
+            "[parameters]\na = { dist = \"normal\", mean = 1.0, sd = 0.1 }\n",
+        )
+        .unwrap_err();
         assert!(e.message.contains("is a distribution"), "{e}");
         let e = crate::sweep::parse_spec("s.toml", "[sweep]\ndesign = \"lhs\"\nsamples = 3\n[parameters]\na = { dist = \"gauss\", mean = 1.0 }\n").unwrap_err();
         assert!(e.message.contains("dist is"), "{e}");
@@ -359,9 +446,20 @@ mod tests {
         let (a, b) = (column(&p, 1), column(&p, 2));
         let ((ma, sa), (mb, sb)) = (moments(&a), moments(&b));
         #[allow(clippy::cast_precision_loss)]
-        let cov = a.iter().zip(&b).map(|(x, y)| (x - ma) * (y - mb)).sum::<f64>() / (a.len() as f64 - 1.0);
-        assert!((ma - 10.0).abs() < 0.02 && (mb - 20.0).abs() < 0.02, "{ma} {mb}");
-        assert!((sa / 2.0 - 1.0).abs() < 0.02 && (sb - 1.0).abs() < 0.02, "{sa} {sb}");
+        let cov = a
+            .iter()
+            .zip(&b)
+            .map(|(x, y)| (x - ma) * (y - mb))
+            .sum::<f64>()
+            / (a.len() as f64 - 1.0);
+        assert!(
+            (ma - 10.0).abs() < 0.02 && (mb - 20.0).abs() < 0.02,
+            "{ma} {mb}"
+        );
+        assert!(
+            (sa / 2.0 - 1.0).abs() < 0.02 && (sb - 1.0).abs() < 0.02,
+            "{sa} {sb}"
+        );
         // correlation 0.6 kept (its standard error is ~0.01 at n = 4000)
         assert!((cov / (sa * sb) - 0.6).abs() < 0.04, "{}", cov / (sa * sb));
     }
@@ -383,7 +481,10 @@ mod tests {
 ///
 /// # Errors
 /// No run, a column no run has, a file that cannot be read or written, the figure.
-pub fn write_band(out_dir: &Path, columns: &[String]) -> Result<(Vec<std::path::PathBuf>, usize), SweepError> {
+pub fn write_band(
+    out_dir: &Path,
+    columns: &[String],
+) -> Result<(Vec<std::path::PathBuf>, usize), SweepError> {
     let dir = out_dir.join("runs");
     let shown = dir.display().to_string();
     let mut files: Vec<_> = std::fs::read_dir(&dir)
@@ -396,23 +497,37 @@ pub fn write_band(out_dir: &Path, columns: &[String]) -> Result<(Vec<std::path::
     let mut t: Vec<f64> = Vec::new();
     let mut runs = Vec::new();
     for f in &files {
-        let text = std::fs::read_to_string(f).map_err(|e| err(&f.display().to_string(), e.to_string()))?;
+        let text =
+            std::fs::read_to_string(f).map_err(|e| err(&f.display().to_string(), e.to_string()))?;
         let mut lines = text.lines();
         let head: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
         let idx: Vec<usize> = columns
             .iter()
             .map(|c| {
                 head.iter().position(|h| h == c).ok_or_else(|| {
-                    err(&f.display().to_string(), format!("[band] column `{c}` is not an output column (they are: {})", head[1..].join(", ")))
+                    err(
+                        &f.display().to_string(),
+                        format!(
+                            "[band] column `{c}` is not an output column (they are: {})",
+                            head[1..].join(", ")
+                        ),
+                    )
                 })
             })
             .collect::<Result<_, _>>()?;
         let mut rows = Vec::new();
         let mut times = Vec::new();
         for l in lines {
-            let cells: Vec<f64> = l.split(',').map(|c| c.trim().parse().unwrap_or(f64::NAN)).collect();
+            let cells: Vec<f64> = l
+                .split(',')
+                .map(|c| c.trim().parse().unwrap_or(f64::NAN))
+                .collect();
             times.push(cells.first().copied().unwrap_or(f64::NAN));
-            rows.push(idx.iter().map(|&j| cells.get(j).copied().unwrap_or(f64::NAN)).collect::<Vec<f64>>());
+            rows.push(
+                idx.iter()
+                    .map(|&j| cells.get(j).copied().unwrap_or(f64::NAN))
+                    .collect::<Vec<f64>>(),
+            );
         }
         if times.len() > t.len() {
             t = times;
@@ -439,8 +554,16 @@ pub fn write_band(out_dir: &Path, columns: &[String]) -> Result<(Vec<std::path::
     std::fs::write(&path, &csv).map_err(|e| err(&path.display().to_string(), e.to_string()))?;
     let mut written = vec![path];
     use bg_model::plots::{Panel, Plot, Series};
-    let results = crate::plot::Results::parse(&csv).map_err(|(l, m)| err("band.csv", format!("line {l}: {m}")))?;
-    let s = |column: String, label: &str, dashed: bool| Series { column, label: label.to_owned(), scale: 1.0, offset: 0.0, dashed, line: 0 };
+    let results = crate::plot::Results::parse(&csv)
+        .map_err(|(l, m)| err("band.csv", format!("line {l}: {m}")))?;
+    let s = |column: String, label: &str, dashed: bool| Series {
+        column,
+        label: label.to_owned(),
+        scale: 1.0,
+        offset: 0.0,
+        dashed,
+        line: 0,
+    };
     let panels = columns
         .iter()
         .flat_map(|c| {
@@ -449,7 +572,11 @@ pub fn write_band(out_dir: &Path, columns: &[String]) -> Result<(Vec<std::path::
                     y_label: c.clone(),
                     unit: None,
                     x_range: None,
-                    series: vec![s(format!("{c}_mean"), "mean", false), s(format!("{c}_q05"), "5 % quantile", true), s(format!("{c}_q95"), "95 % quantile", true)],
+                    series: vec![
+                        s(format!("{c}_mean"), "mean", false),
+                        s(format!("{c}_q05"), "5 % quantile", true),
+                        s(format!("{c}_q95"), "95 % quantile", true),
+                    ],
                     line: 0,
                 },
                 Panel {
@@ -470,6 +597,9 @@ pub fn write_band(out_dir: &Path, columns: &[String]) -> Result<(Vec<std::path::
         panels,
         line: 0,
     };
-    written.extend(crate::plot::draw(&results, &plot, out_dir, crate::plot::Format::Png).map_err(|e| err("band.png", e.to_string()))?);
+    written.extend(
+        crate::plot::draw(&results, &plot, out_dir, crate::plot::Format::Png)
+            .map_err(|e| err("band.png", e.to_string()))?,
+    );
     Ok((written, runs.len()))
 }
