@@ -111,7 +111,7 @@ pub fn command(a: &Args) -> ExitCode {
     if let Some(png) = &a.plot {
         if let Err(e) = history_plot(
             &opt.history,
-            &metric_names[spec.objective.0.min(metric_names.len().saturating_sub(1))],
+            metric_names[spec.objective.0.min(metric_names.len().saturating_sub(1))],
             png,
         ) {
             tell!("error: cannot draw {}: {e}", png.display());

@@ -18,6 +18,11 @@ use nalgebra::{DMatrix, DVector};
 
 use super::problem::Loss;
 
+/// r(p).
+pub type ResidualFn<'a> = dyn Fn(&[f64]) -> Result<Vec<f64>, String> + 'a;
+/// r(p) and ∂r/∂p.
+pub type JacobianFn<'a> = dyn Fn(&[f64]) -> Result<(Vec<f64>, DMatrix<f64>), String> + 'a;
+
 /// Stopping rules.
 #[derive(Clone, Copy, Debug)]
 pub struct LmOptions {
@@ -109,8 +114,8 @@ fn cost_of(r: &[f64], rho: &[f64]) -> f64 {
 /// step, not an error).
 #[allow(clippy::too_many_lines)]
 pub fn lm(
-    residuals: &dyn Fn(&[f64]) -> Result<Vec<f64>, String>,
-    jacobian: &dyn Fn(&[f64]) -> Result<(Vec<f64>, DMatrix<f64>), String>,
+    residuals: &ResidualFn<'_>,
+    jacobian: &JacobianFn<'_>,
     p0: &[f64],
     lo: &[f64],
     hi: &[f64],

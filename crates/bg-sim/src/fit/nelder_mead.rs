@@ -171,6 +171,7 @@ impl SplitMix {
 /// Clerc's constriction) of `particles` in the box, `generations` at most, each
 /// generation's particles evaluated in parallel on the current rayon pool. Stops early when
 /// the swarm's best has not improved by `ftol` (relative) in 15 generations. Seeded.
+#[allow(clippy::too_many_arguments)]
 pub fn particle_swarm(
     f: &(dyn Fn(&[f64]) -> f64 + Sync),
     p0: Option<&[f64]>,

@@ -93,13 +93,7 @@ pub fn stats(p: &[f64], r: &[f64], rho: &[f64], j: &DMatrix<f64>) -> Stats {
     for k in 0..np {
         for l in 0..np {
             let s = d[k] * d[l];
-            scaled[(k, l)] = if s > 0.0 {
-                info[(k, l)] / s
-            } else if k == l {
-                0.0
-            } else {
-                0.0
-            };
+            scaled[(k, l)] = if s > 0.0 { info[(k, l)] / s } else { 0.0 };
         }
     }
     let eig = scaled.clone().symmetric_eigen();

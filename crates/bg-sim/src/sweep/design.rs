@@ -149,6 +149,7 @@ pub fn points(spec: &Spec) -> Vec<Point> {
                     })
                     .collect();
                 if idx.len() == ff.mean.len() {
+                    #[allow(clippy::needless_range_loop)]
                     for i in 0..samples {
                         let z: Vec<f64> = idx
                             .iter()

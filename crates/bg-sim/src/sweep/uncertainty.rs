@@ -327,6 +327,137 @@ pub fn quantile(v: &[f64], q: f64) -> f64 {
     v[lo] + w * (v[hi] - v[lo])
 }
 
+/// Read the runs a sweep kept (`runs/*.csv`), take the band of `columns`, and write
+/// `band.csv` (`t`, then `COL_mean`, `COL_q05`, `COL_q95`, `COL_width` per column) and
+/// `band.png` (per column a panel with the mean solid and the quantiles dashed, and one with
+/// the band's width) into `out_dir`. Returns the
+/// files written and the number of runs used.
+///
+/// # Errors
+/// No run, a column no run has, a file that cannot be read or written, the figure.
+pub fn write_band(
+    out_dir: &Path,
+    columns: &[String],
+) -> Result<(Vec<std::path::PathBuf>, usize), SweepError> {
+    let dir = out_dir.join("runs");
+    let shown = dir.display().to_string();
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .map_err(|e| err(&shown, e.to_string()))?
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "csv"))
+        .collect();
+    files.sort();
+    let mut t: Vec<f64> = Vec::new();
+    let mut runs = Vec::new();
+    for f in &files {
+        let text =
+            std::fs::read_to_string(f).map_err(|e| err(&f.display().to_string(), e.to_string()))?;
+        let mut lines = text.lines();
+        let head: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+        let idx: Vec<usize> = columns
+            .iter()
+            .map(|c| {
+                head.iter().position(|h| h == c).ok_or_else(|| {
+                    err(
+                        &f.display().to_string(),
+                        format!(
+                            "[band] column `{c}` is not an output column (they are: {})",
+                            head[1..].join(", ")
+                        ),
+                    )
+                })
+            })
+            .collect::<Result<_, _>>()?;
+        let mut rows = Vec::new();
+        let mut times = Vec::new();
+        for l in lines {
+            let cells: Vec<f64> = l
+                .split(',')
+                .map(|c| c.trim().parse().unwrap_or(f64::NAN))
+                .collect();
+            times.push(cells.first().copied().unwrap_or(f64::NAN));
+            rows.push(
+                idx.iter()
+                    .map(|&j| cells.get(j).copied().unwrap_or(f64::NAN))
+                    .collect::<Vec<f64>>(),
+            );
+        }
+        if times.len() > t.len() {
+            t = times;
+        }
+        runs.push(rows);
+    }
+    if runs.is_empty() {
+        return Err(err(&shown, "no finished run to take a band of"));
+    }
+    let b = band(&runs, columns.len());
+    let mut csv = String::from("t");
+    for c in columns {
+        csv.push_str(&format!(",{c}_mean,{c}_q05,{c}_q95,{c}_width"));
+    }
+    csv.push('\n');
+    for (i, row) in b.iter().enumerate() {
+        csv.push_str(&format!("{:?}", t[i]));
+        for (m, lo, hi) in row {
+            csv.push_str(&format!(",{m:?},{lo:?},{hi:?},{:?}", hi - lo));
+        }
+        csv.push('\n');
+    }
+    let path = out_dir.join("band.csv");
+    std::fs::write(&path, &csv).map_err(|e| err(&path.display().to_string(), e.to_string()))?;
+    let mut written = vec![path];
+    use bg_model::plots::{Panel, Plot, Series};
+    let results = crate::plot::Results::parse(&csv)
+        .map_err(|(l, m)| err("band.csv", format!("line {l}: {m}")))?;
+    let s = |column: String, label: &str, dashed: bool| Series {
+        column,
+        label: label.to_owned(),
+        scale: 1.0,
+        offset: 0.0,
+        dashed,
+        line: 0,
+    };
+    let panels = columns
+        .iter()
+        .flat_map(|c| {
+            [
+                Panel {
+                    y_label: c.clone(),
+                    unit: None,
+                    x_range: None,
+                    series: vec![
+                        s(format!("{c}_mean"), "mean", false),
+                        s(format!("{c}_q05"), "5 % quantile", true),
+                        s(format!("{c}_q95"), "95 % quantile", true),
+                    ],
+                    line: 0,
+                },
+                Panel {
+                    y_label: format!("{c}: 95 % − 5 %"),
+                    unit: None,
+                    x_range: None,
+                    series: vec![s(format!("{c}_width"), "width of the band", false)],
+                    line: 0,
+                },
+            ]
+        })
+        .collect();
+    let plot = Plot {
+        file: "band".into(),
+        title: format!("Band over {} runs: mean and 5/95 % quantiles", runs.len()),
+        x: "t".into(),
+        x_label: "time [s]".into(),
+        panels,
+        line: 0,
+    };
+    written.extend(
+        crate::plot::draw(&results, &plot, out_dir, crate::plot::Format::Png)
+            .map_err(|e| err("band.png", e.to_string()))?,
+    );
+    Ok((written, runs.len()))
+}
+
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used)]
@@ -471,135 +602,4 @@ mod tests {
         let b = band(&runs, 1);
         assert_eq!(b[0][0], (50.0, 5.0, 95.0));
     }
-}
-
-/// Read the runs a sweep kept (`runs/*.csv`), take the band of `columns`, and write
-/// `band.csv` (`t`, then `COL_mean`, `COL_q05`, `COL_q95`, `COL_width` per column) and
-/// `band.png` (per column a panel with the mean solid and the quantiles dashed, and one with
-/// the band's width) into `out_dir`. Returns the
-/// files written and the number of runs used.
-///
-/// # Errors
-/// No run, a column no run has, a file that cannot be read or written, the figure.
-pub fn write_band(
-    out_dir: &Path,
-    columns: &[String],
-) -> Result<(Vec<std::path::PathBuf>, usize), SweepError> {
-    let dir = out_dir.join("runs");
-    let shown = dir.display().to_string();
-    let mut files: Vec<_> = std::fs::read_dir(&dir)
-        .map_err(|e| err(&shown, e.to_string()))?
-        .filter_map(Result::ok)
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|x| x == "csv"))
-        .collect();
-    files.sort();
-    let mut t: Vec<f64> = Vec::new();
-    let mut runs = Vec::new();
-    for f in &files {
-        let text =
-            std::fs::read_to_string(f).map_err(|e| err(&f.display().to_string(), e.to_string()))?;
-        let mut lines = text.lines();
-        let head: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
-        let idx: Vec<usize> = columns
-            .iter()
-            .map(|c| {
-                head.iter().position(|h| h == c).ok_or_else(|| {
-                    err(
-                        &f.display().to_string(),
-                        format!(
-                            "[band] column `{c}` is not an output column (they are: {})",
-                            head[1..].join(", ")
-                        ),
-                    )
-                })
-            })
-            .collect::<Result<_, _>>()?;
-        let mut rows = Vec::new();
-        let mut times = Vec::new();
-        for l in lines {
-            let cells: Vec<f64> = l
-                .split(',')
-                .map(|c| c.trim().parse().unwrap_or(f64::NAN))
-                .collect();
-            times.push(cells.first().copied().unwrap_or(f64::NAN));
-            rows.push(
-                idx.iter()
-                    .map(|&j| cells.get(j).copied().unwrap_or(f64::NAN))
-                    .collect::<Vec<f64>>(),
-            );
-        }
-        if times.len() > t.len() {
-            t = times;
-        }
-        runs.push(rows);
-    }
-    if runs.is_empty() {
-        return Err(err(&shown, "no finished run to take a band of"));
-    }
-    let b = band(&runs, columns.len());
-    let mut csv = String::from("t");
-    for c in columns {
-        csv.push_str(&format!(",{c}_mean,{c}_q05,{c}_q95,{c}_width"));
-    }
-    csv.push('\n');
-    for (i, row) in b.iter().enumerate() {
-        csv.push_str(&format!("{:?}", t[i]));
-        for (m, lo, hi) in row {
-            csv.push_str(&format!(",{m:?},{lo:?},{hi:?},{:?}", hi - lo));
-        }
-        csv.push('\n');
-    }
-    let path = out_dir.join("band.csv");
-    std::fs::write(&path, &csv).map_err(|e| err(&path.display().to_string(), e.to_string()))?;
-    let mut written = vec![path];
-    use bg_model::plots::{Panel, Plot, Series};
-    let results = crate::plot::Results::parse(&csv)
-        .map_err(|(l, m)| err("band.csv", format!("line {l}: {m}")))?;
-    let s = |column: String, label: &str, dashed: bool| Series {
-        column,
-        label: label.to_owned(),
-        scale: 1.0,
-        offset: 0.0,
-        dashed,
-        line: 0,
-    };
-    let panels = columns
-        .iter()
-        .flat_map(|c| {
-            [
-                Panel {
-                    y_label: c.clone(),
-                    unit: None,
-                    x_range: None,
-                    series: vec![
-                        s(format!("{c}_mean"), "mean", false),
-                        s(format!("{c}_q05"), "5 % quantile", true),
-                        s(format!("{c}_q95"), "95 % quantile", true),
-                    ],
-                    line: 0,
-                },
-                Panel {
-                    y_label: format!("{c}: 95 % − 5 %"),
-                    unit: None,
-                    x_range: None,
-                    series: vec![s(format!("{c}_width"), "width of the band", false)],
-                    line: 0,
-                },
-            ]
-        })
-        .collect();
-    let plot = Plot {
-        file: "band".into(),
-        title: format!("Band over {} runs: mean and 5/95 % quantiles", runs.len()),
-        x: "t".into(),
-        x_label: "time [s]".into(),
-        panels,
-        line: 0,
-    };
-    written.extend(
-        crate::plot::draw(&results, &plot, out_dir, crate::plot::Format::Png)
-            .map_err(|e| err("band.png", e.to_string()))?,
-    );
-    Ok((written, runs.len()))
 }
