@@ -10,6 +10,7 @@
 //!   chamber, a payload mass into the arm's mass matrix), so it has no seed in the plan;
 //!   the twin's right-hand side at the same (t, x) differences it, one-sided, with
 //!   h_k = 2⁻²⁶·max(|p_k|, 10⁻³) (relative error about 10⁻⁸).
+//!
 //! Output sensitivities are the directional difference of the twin's outputs,
 //! (y(t, x + h_k s_k; p + h_k) − y(t, x; p))/h_k, which carries both ∂y/∂x·s and ∂y/∂p.
 //! Events (parameter switches) are applied to every twin at the same time, each with its
@@ -20,7 +21,7 @@
 
 use nalgebra::DMatrix;
 
-use crate::equations::StateEquations;
+use crate::equations::{StateEquations, Subset};
 use crate::error::SimulationError;
 use crate::radau::{OdeSystem, Radau5, RadauOptions, Sensitivities, SensitivityRhs};
 use crate::simulate::{Event, Output, Settings};
@@ -157,6 +158,8 @@ struct Rows<'e> {
     eqs: &'e StateEquations,
     twins: &'e [Perturbation],
     outputs: &'e [Output],
+    /// The stages the outputs need, in the model and in each twin.
+    subsets: &'e [Subset],
     xs: Vec<f64>,
     run: SensitivityRun,
 }
@@ -165,7 +168,7 @@ impl Rows<'_> {
     fn record(&mut self, t: f64, x: &[f64], s: &[f64]) {
         let (n, np, m) = (x.len(), self.twins.len(), self.outputs.len());
         self.run.t.push(t);
-        self.eqs.evaluate(t, x);
+        self.eqs.evaluate_only(&self.subsets[0], t, x);
         let base = self.run.y.len();
         for o in self.outputs {
             self.run.y.push(self.eqs.read(o.probe, t, x));
@@ -176,7 +179,7 @@ impl Rows<'_> {
             for i in 0..n {
                 self.xs[i] = x[i] + w.h * s[k * n + i];
             }
-            w.eqs.evaluate(t, &self.xs);
+            w.eqs.evaluate_only(&self.subsets[k + 1], t, &self.xs);
             for (j, o) in self.outputs.iter().enumerate() {
                 let yp = w.eqs.read(o.probe, t, &self.xs);
                 self.run.dy_dp[d0 + j * np + k] = (yp - self.run.y[base + j]) / w.h;
@@ -265,6 +268,10 @@ pub fn simulate_sensitivities(
     let mut s = s0.to_vec();
     let mut t = t0;
     let mut next_row = 0usize;
+    let probes: Vec<crate::equations::Probe> = outputs.iter().map(|o| o.probe).collect();
+    let subsets: Vec<Subset> = std::iter::once(eqs.subset(&probes))
+        .chain(twins.iter().map(|w| w.eqs.subset(&probes)))
+        .collect();
     let mut xi = vec![0.0; n];
     let mut si = vec![0.0; n * np];
     // every row's storage at once: nothing grows while stepping
@@ -297,6 +304,7 @@ pub fn simulate_sensitivities(
             eqs,
             twins,
             outputs,
+            subsets: &subsets,
             xs: vec![0.0; n],
             run: std::mem::take(&mut run),
         };

@@ -176,9 +176,28 @@ impl Sensitivities {
         self.s_prev.copy_from_slice(&self.s);
         for k in 0..self.np {
             let col = k * n..(k + 1) * n;
-            for j in 0..3 {
-                self.z[j].fill(0.0);
-                self.w[j].fill(0.0);
+            // Starting values: the last step's collocation polynomial, extrapolated (as the
+            // state's Newton iteration starts).
+            if self.has_poly {
+                let ratio = h / self.h_last;
+                let sc = [tab.c[0] * ratio, tab.c[1] * ratio, tab.c[2] * ratio];
+                let (c1m1, c2m1) = (tab.c[0] - 1.0, tab.c[1] - 1.0);
+                for i in 0..n {
+                    let ci = k * n + i;
+                    let (a1, a2, a3) = (self.cont[0][ci], self.cont[1][ci], self.cont[2][ci]);
+                    let zk = |q: usize| sc[q] * (a1 + (sc[q] - c2m1) * (a2 + (sc[q] - c1m1) * a3));
+                    let zi = [zk(0), zk(1), zk(2)];
+                    for q in 0..3 {
+                        self.z[q][i] = zi[q];
+                        self.w[q][i] =
+                            tab.ti[q][0] * zi[0] + tab.ti[q][1] * zi[1] + tab.ti[q][2] * zi[2];
+                    }
+                }
+            } else {
+                for j in 0..3 {
+                    self.z[j].fill(0.0);
+                    self.w[j].fill(0.0);
+                }
             }
             let mut converged = false;
             let mut renewed = false;
