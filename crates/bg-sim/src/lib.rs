@@ -11,6 +11,7 @@ use bg_model::Registry;
 
 pub mod bench;
 pub mod energy;
+pub mod fit;
 pub mod graph;
 pub mod kinds;
 pub mod modes;

@@ -18,6 +18,7 @@ use commands::{
     bench, check, compare, energy, fmu, graph, kinds, linearize, modes, plot, reduce, run, sea,
     stress, sweep, FAILED,
 };
+use commands::{fit, optimize};
 
 #[derive(Parser)]
 #[command(
@@ -91,6 +92,12 @@ enum Command {
     /// elevation and, with --rao, the vessel's heave, sway and roll at a point; --plot draws
     /// the record and its spectrum against the target (docs/sea-states.md).
     Sea(sea::Args),
+    /// Fit parameters to measured data (weighted least squares, bounded Levenberg–Marquardt):
+    /// estimates, standard errors, 95 % intervals, correlations, warnings (docs/fit.md).
+    Fit(fit::Args),
+    /// Minimise a sweep metric subject to constraints on others over bounded parameters, by a
+    /// particle swarm (or Nelder–Mead) whose runs go in parallel (docs/fit.md).
+    Optimize(optimize::Args),
 }
 
 fn main() -> ExitCode {
@@ -142,5 +149,7 @@ fn dispatch(command: Command) -> ExitCode {
         Command::Stress(a) => stress::command(&a),
         Command::Fatigue(a) => fatigue::command(&a),
         Command::Sea(a) => sea::command(&a),
+        Command::Fit(a) => fit::command(a),
+        Command::Optimize(a) => optimize::command(&a),
     }
 }

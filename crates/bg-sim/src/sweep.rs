@@ -28,9 +28,11 @@
 
 mod csv;
 mod design;
+pub mod optimize;
 mod run;
 mod spec;
 mod summary;
+pub mod uncertainty;
 
 use std::collections::HashMap;
 use std::fs::{self, OpenOptions};
@@ -104,6 +106,8 @@ pub struct Summary {
     pub run_s: f64,
     /// Runs skipped because of an interrupt (to be done by a resume).
     pub interrupted: usize,
+    /// The band's files (`band.csv`, `band.png`), if the spec asks for one.
+    pub band: Vec<PathBuf>,
 }
 
 /// Run a sweep of the model at `model_path`; see the module doc. Runs already in
@@ -167,7 +171,7 @@ pub fn sweep(
     }
     let todo: Vec<&Point> = all.iter().filter(|p| !done.contains_key(&p.id())).collect();
     let skipped = all.len() - todo.len();
-    let keep = if spec.keep_runs {
+    let keep = if spec.keep_runs || !spec.band.is_empty() {
         let d = opts.out_dir.join("runs");
         fs::create_dir_all(&d).map_err(|e| err(&d.display().to_string(), e.to_string()))?;
         Some(d)
@@ -253,7 +257,14 @@ pub fn sweep(
     fs::write(&tmp, out)
         .and_then(|()| fs::rename(&tmp, &path))
         .map_err(|e| err(&shown, format!("cannot write the summary: {e}")))?;
+    // the band over time of the runs kept ([band], docs/sweeps.md)
+    let band = if spec.band.is_empty() || interrupted > 0 {
+        Vec::new()
+    } else {
+        uncertainty::write_band(&opts.out_dir, &spec.band)?.0
+    };
     Ok(Summary {
+        band,
         path,
         total: all.len(),
         skipped,

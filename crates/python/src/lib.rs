@@ -6,6 +6,7 @@
 //! `Model` holds `RefCell`s and cannot cross threads, while a path and a list of strings
 //! pickle, so the same calls run on Dask workers. Loading costs milliseconds.
 
+mod fit;
 mod sensitivity;
 mod stepping;
 
@@ -326,6 +327,8 @@ fn sweep<'py>(
 /// Bond-graph model files from Python (the compiled half of `bgsim`).
 #[pymodule]
 mod _bgsim {
+    #[pymodule_export]
+    use super::fit::fit;
     #[pymodule_export]
     use super::sensitivity::sensitivity;
     #[pymodule_export]

@@ -126,6 +126,9 @@ fn sweep(model: &Path, spec: &Path, jobs: usize, out_dir: PathBuf) -> ExitCode {
                 rayon_threads(jobs)
             );
             say!("summary: {}", s.path.display());
+            for f in &s.band {
+                say!("band: {}", f.display());
+            }
             if s.interrupted > 0 || s.not_ok > 0 {
                 ExitCode::from(FAILED)
             } else {

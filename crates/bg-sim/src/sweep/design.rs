@@ -56,6 +56,8 @@ pub fn points(spec: &Spec) -> Vec<Point> {
                 .iter()
                 .map(|(_, v)| match v {
                     Values::List(l) => l.clone(),
+                    // refused by the parser: a distribution has no grid
+                    Values::Dist(_) => vec![Value::Num(f64::NAN)],
                     Values::Range { from, to, n, log } => {
                         let n = (*n).max(1);
                         (0..n)
@@ -93,23 +95,33 @@ pub fn points(spec: &Spec) -> Vec<Point> {
                 })
                 .collect()
         }
-        Design::Lhs { samples, seed } => {
+        Design::Lhs { samples, seed } | Design::MonteCarlo { samples, seed } => {
+            let lhs = matches!(spec.design, Design::Lhs { .. });
             let mut rng = SplitMix(seed);
-            // one random permutation of the strata per parameter
-            let columns: Vec<Vec<Value>> = spec
+            // one random permutation of the strata per parameter (Monte Carlo: u at random)
+            let mut columns: Vec<Vec<Value>> = spec
                 .parameters
                 .iter()
                 .map(|(_, v)| {
                     let mut strata: Vec<usize> = (0..samples).collect();
-                    for i in (1..samples).rev() {
-                        strata.swap(i, rng.below(i + 1));
+                    if lhs {
+                        for i in (1..samples).rev() {
+                            strata.swap(i, rng.below(i + 1));
+                        }
                     }
                     strata
                         .into_iter()
                         .map(|s| {
                             #[allow(clippy::cast_precision_loss)]
-                            let u = (s as f64 + rng.unit()) / samples as f64;
+                            let u = if lhs {
+                                (s as f64 + rng.unit()) / samples as f64
+                            } else {
+                                rng.unit()
+                            };
+                            // strictly inside (0, 1): the inverse distribution functions
+                            let u = u.clamp(1e-12, 1.0 - 1e-12);
                             match v {
+                                Values::Dist(d) => Value::Num(d.at(u)),
                                 Values::Range { from, to, log, .. } => {
                                     Value::Num(range_value(*from, *to, *log, u))
                                 }
@@ -127,6 +139,31 @@ pub fn points(spec: &Spec) -> Vec<Point> {
                         .collect()
                 })
                 .collect();
+            // a fit's components: z → p̂ + L z, sample by sample
+            if let Some(ff) = &spec.from_fit {
+                let idx: Vec<usize> = (0..ff.mean.len())
+                    .filter_map(|k| {
+                        spec.parameters
+                            .iter()
+                            .position(|(_, v)| matches!(v, Values::Dist(super::uncertainty::Dist::FromFit(j)) if *j == k))
+                    })
+                    .collect();
+                if idx.len() == ff.mean.len() {
+                    #[allow(clippy::needless_range_loop)]
+                    for i in 0..samples {
+                        let z: Vec<f64> = idx
+                            .iter()
+                            .map(|&j| match columns[j][i] {
+                                Value::Num(z) => z,
+                                Value::Text(_) => 0.0,
+                            })
+                            .collect();
+                        for (x, &j) in ff.sample(&z).into_iter().zip(&idx) {
+                            columns[j][i] = Value::Num(x);
+                        }
+                    }
+                }
+            }
             (0..samples)
                 .map(|index| Point {
                     index,

@@ -3,6 +3,7 @@
 
 use bg_model::expr::Expr;
 
+use super::uncertainty::{parse_dist, Dist, FromFit};
 use super::{err, SweepError, MAX_RUNS};
 
 /// A value given to one `--set` path.
@@ -42,6 +43,9 @@ pub enum Values {
         /// Spaced evenly in log10 (both ends > 0).
         log: bool,
     },
+    /// A distribution, sampled by Monte Carlo or a Latin hypercube
+    /// ([`super::uncertainty`]).
+    Dist(Dist),
 }
 
 /// How the parameters' values combine into runs.
@@ -51,6 +55,13 @@ pub enum Design {
     Grid,
     /// A Latin-hypercube sample of `samples` points, reproducible from `seed`.
     Lhs {
+        /// Number of runs.
+        samples: usize,
+        /// Seed of the generator.
+        seed: u64,
+    },
+    /// Independent random samples (the distributions' own; ranges and lists uniform).
+    MonteCarlo {
         /// Number of runs.
         samples: usize,
         /// Seed of the generator.
@@ -124,6 +135,11 @@ pub struct Spec {
     pub metrics: Vec<Metric>,
     /// Also write every run's full results to `runs/`.
     pub keep_runs: bool,
+    /// The multivariate normal of a fit (`[from_fit]`), whose parameters are entries of
+    /// `parameters` with [`Dist::FromFit`].
+    pub from_fit: Option<FromFit>,
+    /// Columns whose band over time (mean, 5/95 % quantiles) the sweep writes (`[band]`).
+    pub band: Vec<String>,
 }
 
 /// Parse a sweep spec; `file` names it in errors, with the line of the key at fault
@@ -180,11 +196,11 @@ fn parse(file: &str, text: &str) -> Result<Spec, (At, SweepError)> {
         ))
     })?;
     for key in table.keys() {
-        if !["sweep", "parameters", "metrics"].contains(&key.as_str()) {
+        if !["sweep", "parameters", "metrics", "from_fit", "band"].contains(&key.as_str()) {
             return Err(nowhere(err(
                 file,
                 format!(
-                    "unknown section `{key}`; a sweep spec has [sweep], [parameters] and [metrics]"
+                    "unknown section `{key}`; a sweep spec has [sweep], [parameters], [metrics], [from_fit] and [band]"
                 ),
             )));
         }
@@ -222,9 +238,9 @@ fn parse(file: &str, text: &str) -> Result<Spec, (At, SweepError)> {
             }
             Design::Grid
         }
-        Some(Some("lhs")) => {
+        Some(Some(d @ ("lhs" | "monte_carlo"))) => {
             let samples = int("samples")?.ok_or_else(|| {
-                at("sweep", "design")(err(file, "design = \"lhs\" needs samples = N"))
+                at("sweep", "design")(err(file, format!("design = \"{d}\" needs samples = N")))
             })?;
             let samples = usize::try_from(samples).unwrap_or(usize::MAX);
             if samples == 0 || samples > MAX_RUNS {
@@ -233,15 +249,17 @@ fn parse(file: &str, text: &str) -> Result<Spec, (At, SweepError)> {
                     format!("samples must be 1 to {MAX_RUNS}"),
                 )));
             }
-            Design::Lhs {
-                samples,
-                seed: int("seed")?.unwrap_or(0),
+            let seed = int("seed")?.unwrap_or(0);
+            if d == "lhs" {
+                Design::Lhs { samples, seed }
+            } else {
+                Design::MonteCarlo { samples, seed }
             }
         }
         Some(_) => {
             return Err(at("sweep", "design")(err(
                 file,
-                "[sweep] design is \"grid\" or \"lhs\"",
+                "[sweep] design is \"grid\", \"lhs\" or \"monte_carlo\"",
             )))
         }
     };
@@ -271,6 +289,71 @@ fn parse(file: &str, text: &str) -> Result<Spec, (At, SweepError)> {
                 path,
                 parse_values(file, name, v).map_err(at("parameters", name))?,
             ));
+        }
+    }
+    let from_fit = match table.get("from_fit") {
+        None => None,
+        Some(toml::Value::Table(t)) => {
+            let Some(f) = t
+                .get("file")
+                .and_then(toml::Value::as_str)
+                .filter(|_| t.len() == 1)
+            else {
+                return Err(nowhere(err(
+                    file,
+                    "[from_fit] has one key, file = \"FIT.json\"",
+                )));
+            };
+            // relative to the spec
+            let path = std::path::Path::new(file)
+                .parent()
+                .unwrap_or(std::path::Path::new(""))
+                .join(f);
+            let ff = FromFit::read(&path, file).map_err(nowhere)?;
+            for (k, p) in ff.paths.iter().enumerate() {
+                if parameters.iter().any(|(q, _)| q == p) {
+                    return Err(nowhere(err(
+                        file,
+                        format!("`{p}` is both in [parameters] and in the fit of [from_fit]"),
+                    )));
+                }
+                parameters.push((p.clone(), Values::Dist(Dist::FromFit(k))));
+            }
+            Some(ff)
+        }
+        Some(_) => return Err(nowhere(err(file, "`from_fit` must be a table"))),
+    };
+    let band = match table.get("band") {
+        None => Vec::new(),
+        Some(toml::Value::Table(t)) => {
+            match (t.get("columns").and_then(toml::Value::as_array), t.len()) {
+                (Some(a), 1) if !a.is_empty() => a
+                    .iter()
+                    .map(|c| {
+                        c.as_str().map(str::to_owned).ok_or_else(|| {
+                            nowhere(err(file, "[band] columns are names of output columns"))
+                        })
+                    })
+                    .collect::<Result<_, _>>()?,
+                _ => {
+                    return Err(nowhere(err(
+                        file,
+                        "[band] has one key, columns = [\"y1\", …]",
+                    )))
+                }
+            }
+        }
+        Some(_) => return Err(nowhere(err(file, "`band` must be a table"))),
+    };
+    if design == Design::Grid {
+        if let Some((k, _)) = parameters
+            .iter()
+            .find(|(_, v)| matches!(v, Values::Dist(_)))
+        {
+            return Err(nowhere(err(
+                file,
+                format!("`{k}` is a distribution: sample it with design = \"lhs\" or \"monte_carlo\" (samples = N, seed = S)"),
+            )));
         }
     }
     if parameters.is_empty() {
@@ -312,6 +395,8 @@ fn parse(file: &str, text: &str) -> Result<Spec, (At, SweepError)> {
         design,
         metrics,
         keep_runs,
+        from_fit,
+        band,
     };
     let n = run_count(&spec);
     if n > MAX_RUNS {
@@ -352,6 +437,9 @@ fn parse_values(file: &str, name: &str, v: &toml::Value) -> Result<Values, Sweep
             a.iter().map(scalar).collect::<Result<_, _>>()?,
         )),
         toml::Value::Array(_) => Err(err(file, format!("`{name}`: the list is empty"))),
+        toml::Value::Table(t) if t.contains_key("dist") => {
+            Ok(Values::Dist(parse_dist(name, t, file)?))
+        }
         toml::Value::Table(t) => {
             for k in t.keys() {
                 if !["from", "to", "n", "scale"].contains(&k.as_str()) {
@@ -484,13 +572,14 @@ pub fn parse_metric(name: &str, src: &str) -> Result<Metric, String> {
 /// How many runs `spec` asks for: its samples, or the product of its grid's lengths.
 pub(super) fn run_count(spec: &Spec) -> usize {
     match spec.design {
-        Design::Lhs { samples, .. } => samples,
+        Design::Lhs { samples, .. } | Design::MonteCarlo { samples, .. } => samples,
         Design::Grid => spec
             .parameters
             .iter()
             .map(|(_, v)| match v {
                 Values::List(l) => l.len(),
                 Values::Range { n, .. } => (*n).max(1),
+                Values::Dist(_) => 1,
             })
             .fold(1usize, usize::saturating_mul),
     }

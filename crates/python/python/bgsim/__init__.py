@@ -315,6 +315,54 @@ class Model:
             raise RunError(f"{self.path}: {error}", df, stats)
         return df
 
+    def fit(
+        self,
+        data: Union[pd.DataFrame, Sequence[pd.DataFrame]],
+        params: Mapping[str, Sequence[float]],
+        outputs: Optional[Sequence[str]] = None,
+        weights: Optional[Mapping[str, float]] = None,
+        loss: str = "l2",
+        method: str = "lm",
+        t_end: Optional[float] = None,
+        rtol: Optional[float] = None,
+        inputs_interp: Optional[str] = None,
+        max_iterations: int = 50,
+    ) -> Dict[str, Any]:
+        """Fit parameters to measured data, as ``bg-sim fit`` (docs/fit.md).
+
+        ``data`` is one DataFrame or a list of them (one per experiment), each with a ``t``
+        column, columns named after ``[outputs]`` (fitted) and after ``[inputs]`` (driving
+        the run). ``params`` maps a name (``"beta"``, ``"elements.cyl1.beta"``) to
+        ``(lo, hi)`` or ``(lo, hi, start)``. Returns the report of ``bg-sim fit --format
+        json``: ``{"estimates": {name: {"value", "stderr", "ci95", "at_bound"}},
+        "correlation": {"names", "matrix"}, "cost", "iterations", "runs", "converged",
+        "warnings", "covariance": {"names", "matrix"}}``. Bad input raises
+        :class:`BgSimError` with file, line and column.
+        """
+        frames = [data] if isinstance(data, pd.DataFrame) else list(data)
+        texts = [(f"data[{k}]", df.to_csv(index=False, float_format="%.17g")) for k, df in enumerate(frames)]
+        ps = []
+        for name, b in params.items():
+            b = tuple(float(v) for v in b)
+            if len(b) not in (2, 3):
+                raise BgSimError(f"params[{name!r}]: give (lo, hi) or (lo, hi, start)")
+            ps.append((name, b[0], b[1], b[2] if len(b) == 3 else None))
+        report = _bgsim.fit(
+            self.path,
+            _overrides(self.set),
+            texts,
+            ps,
+            list(outputs) if outputs is not None else None,
+            [(k, float(v)) for k, v in (weights or {}).items()],
+            loss,
+            method,
+            t_end,
+            rtol,
+            inputs_interp,
+            max_iterations,
+        )
+        return json.loads(report)
+
     def sensitivity(
         self,
         params: Sequence[str],
@@ -494,3 +542,37 @@ def dask_sweep(
     )
     rows = client.gather(futures)
     return pd.DataFrame(rows)
+
+
+def _run_columns(model: str, values: Dict[str, Scalar], columns: List[str]) -> Dict[str, np.ndarray]:
+    d = Model(model, set=values).run(as_dict=True)
+    return {c: np.asarray(d[c]) for c in ["t", *columns]}
+
+
+def dask_band(
+    client: Any,
+    model: PathLike,
+    spec: PathLike,
+    columns: Sequence[str],
+) -> pd.DataFrame:
+    """The band of ``columns`` over time across the runs of a sweep spec (its sampled
+    points: distributions, ``[from_fit]``), the runs mapped over a ``dask.distributed``
+    ``client``: per output row the mean and the 5 % and 95 % quantiles, as ``bg-sim sweep``
+    writes them to ``band.csv`` (``t``, ``COL_mean``, ``COL_q05``, ``COL_q95``,
+    ``COL_width``). A run that fails raises. The model file must be readable by the workers
+    at the same path."""
+    model = os.path.abspath(os.fspath(model))
+    pts = sweep_points(spec)
+    cols = list(columns)
+    futures = client.map(_run_columns, [model] * len(pts), [dict(p) for p in pts], [cols] * len(pts), pure=False)
+    runs = client.gather(futures)
+    n = min(len(r["t"]) for r in runs)
+    out = {"t": runs[0]["t"][:n]}
+    for c in cols:
+        a = np.vstack([r[c][:n] for r in runs])
+        lo, hi = np.quantile(a, 0.05, axis=0), np.quantile(a, 0.95, axis=0)
+        out[f"{c}_mean"] = a.mean(axis=0)
+        out[f"{c}_q05"] = lo
+        out[f"{c}_q95"] = hi
+        out[f"{c}_width"] = hi - lo
+    return pd.DataFrame(out)

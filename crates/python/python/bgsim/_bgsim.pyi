@@ -48,3 +48,17 @@ def spec_metrics(spec: str) -> List[Tuple[str, str]]: ...
 def sweep(
     model: str, spec: str, out_dir: str, jobs: int = 0
 ) -> Tuple["os.PathLike[str]", Dict[str, Any]]: ...
+def fit(
+    path: str,
+    set: List[str],
+    data: List[Tuple[str, str]],
+    params: List[Tuple[str, float, float, Optional[float]]],
+    outputs: Optional[List[str]] = None,
+    weights: List[Tuple[str, float]] = ...,
+    loss: str = "l2",
+    method: str = "lm",
+    t_end: Optional[float] = None,
+    rtol: Optional[float] = None,
+    inputs_interp: Optional[str] = None,
+    max_iterations: int = 50,
+) -> str: ...
