@@ -255,6 +255,15 @@ pub trait Element: Debug {
         false
     }
 
+    /// Whether the core's local differences of this element (where it gives no partials)
+    /// are central whatever the number of perturbed scalars: for a law that loses digits to
+    /// cancellation (a stiff wire's stretch, the small difference of two long distances),
+    /// where forward differences at √ε would keep too few. `false` (the default): central up
+    /// to a few scalars, forward above.
+    fn central_differences(&self) -> bool {
+        false
+    }
+
     /// Whether every partial this element gives ([`stage_partials`](Element::stage_partials),
     /// [`derivative_partials`](Element::derivative_partials)) is the same at every (t, x): a
     /// junction's ±1, a constant ratio or resistance. The Jacobian then asks for them once,

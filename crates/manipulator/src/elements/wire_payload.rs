@@ -273,6 +273,17 @@ impl Element for WirePayload {
         let n = 1 + usize::from(self.spec.winch);
         CausalRule::Fixed(vec![PortCausality::EffortOut; n])
     }
+    /// The payload is an open subsystem: gravity and a moving deck do work on it, it stores
+    /// kinetic and strain energy and its wire and contact dissipate. The energy audit counts
+    /// it at the graph's boundary (its net port power as supplied), not its inner balance.
+    /// The stretch is the small difference of two long distances (tip to payload, paid-out
+    /// length) times a stiff EA/L: forward differences at √ε keep too few digits of it.
+    fn central_differences(&self) -> bool {
+        true
+    }
+    fn energy_role(&self, _: usize) -> bondgraph::EnergyRole {
+        bondgraph::EnergyRole::Source
+    }
     fn states(&self) -> Vec<StateSpec> {
         let mut s: Vec<StateSpec> = ["x", "y", "px", "py"]
             .iter()

@@ -114,6 +114,8 @@ pub(super) struct Differences {
     pub(super) cells: Vec<(Cell, Src)>,
     /// Per (cell k, row r), at k·rows + r: its first update; one more ends the last.
     pub(super) first: Vec<u32>,
+    /// Central differences whatever the number of cells ([`Element::central_differences`](crate::Element::central_differences)).
+    pub(super) central: bool,
 }
 
 /// One block of the pass: a stage of an element, or its state derivatives.
@@ -487,6 +489,7 @@ impl StateEquations {
                 Differences {
                     cells: fd_cells,
                     first,
+                    central: element.central_differences(),
                 }
             });
             let constant = entries

@@ -287,7 +287,7 @@ impl<'a> Pass<'a> {
         for (r, row) in b.rows.iter().enumerate() {
             self.w.base[r] = self.get(row.0);
         }
-        let central = d.cells.len() <= CENTRAL_MAX;
+        let central = d.central || d.cells.len() <= CENTRAL_MAX;
         for (k, &(cell, src)) in d.cells.iter().enumerate() {
             if !self.depends(src) {
                 continue;
