@@ -17,8 +17,11 @@ use bondgraph::Output;
 
 use super::{interrupt_on_signals, BAD_INPUT, FAILED};
 
+mod fatigue;
 mod plot;
 mod report;
+
+use fatigue::HotFatigue;
 
 use plot::figures;
 use report::{csv_report, json_report, text_report};
@@ -71,6 +74,15 @@ pub struct Args {
     /// the run).
     #[arg(long, value_name = "DATA.csv")]
     pub inputs: Option<PathBuf>,
+    /// Rainflow-count each link's hot-spot history and give its Miner damage on this S–N
+    /// curve (as `bg-sim fatigue --sn`): a preset (`ec3-71`, `dnv-d`, …) or
+    /// `m=3,range=71e6,cycles=2e6[,knee=5e6,m2=5,cutoff=1e8]` (range in Pa).
+    #[arg(long, value_name = "CURVE")]
+    pub fatigue: Option<String>,
+    /// With --fatigue: the run repeats N times a year (the residue closed by the repetition,
+    /// the life also in years).
+    #[arg(long, value_name = "N", requires = "fatigue")]
+    pub repeat_per_year: Option<f64>,
 }
 
 /// The quantities of the envelopes, in the JSON's order.
@@ -86,6 +98,8 @@ struct LinkEnvelope {
     has_sigma: bool,
     /// (x index, t, σ) of the largest |σ|, and the column of its history.
     hot: Option<(usize, f64, f64, String)>,
+    /// The hot spot's fatigue (`--fatigue`).
+    fatigue: Option<HotFatigue>,
 }
 
 /// The max and min of a quantity at each x over the run, with their times.
@@ -156,6 +170,18 @@ pub fn command(a: &Args) -> ExitCode {
     }
     if a.points < 2 || a.points > 4096 {
         return bad(format!("--points {}: needs 2 to 4096", a.points));
+    }
+    let curve = match a.fatigue.as_deref().map(bg_fatigue::SnCurve::parse) {
+        None => None,
+        Some(Ok(c)) => Some(c),
+        Some(Err(e)) => return bad(format!("--fatigue: {e}")),
+    };
+    if let Some(n) = a.repeat_per_year {
+        if !(n.is_finite() && n > 0.0) {
+            return bad(format!(
+                "--repeat-per-year {n}: expected a finite number > 0\n  hint: --repeat-per-year 2000"
+            ));
+        }
     }
     let cylinders = elements_of_kind(&text, "hydraulics.cylinder");
     let mut sets = a.set.clone();
@@ -323,6 +349,15 @@ pub fn command(a: &Args) -> ExitCode {
             x,
             env,
             has_sigma: *sigma,
+            fatigue: curve.as_ref().zip(hot.as_ref()).and_then(|(c, h)| {
+                let history = col(&h.3);
+                if history.iter().all(|v| v.is_finite()) {
+                    Some(HotFatigue::of(&history, &h.3, c, a.repeat_per_year))
+                } else {
+                    tell!("warning: {arm} link {k}: the hot spot's history is not finite: no fatigue count");
+                    None
+                }
+            }),
             hot,
         });
     }
@@ -348,7 +383,7 @@ pub fn command(a: &Args) -> ExitCode {
         tell!("warning: {}: buckling_margin is null: the cylinder has no rod check (rod_d, E, buckling; docs/fatigue.md)", c.name);
     }
     match a.format {
-        StressFormat::Json => say!("{:#}", json_report(&envelopes, &peaks)),
+        StressFormat::Json => say!("{:#}", json_report(&envelopes, &peaks, curve.is_some())),
         StressFormat::Csv => say!("{}", csv_report(&envelopes).trim_end()),
         StressFormat::Text => say!("{}", text_report(&envelopes, &peaks).trim_end()),
     }

@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 
 use serde_json::{json, Value};
 
-use super::{CylinderPeaks, LinkEnvelope, QUANTITIES};
+use super::{CylinderPeaks, HotFatigue, LinkEnvelope, QUANTITIES};
 
 fn num(v: f64) -> Value {
     if v.is_finite() {
@@ -15,7 +15,8 @@ fn num(v: f64) -> Value {
     }
 }
 
-pub(super) fn json_report(links: &[LinkEnvelope], cyl: &[CylinderPeaks]) -> Value {
+/// The JSON report; with `fatigue` (`--fatigue` given) each `hot_spot` has a `fatigue` key.
+pub(super) fn json_report(links: &[LinkEnvelope], cyl: &[CylinderPeaks], fatigue: bool) -> Value {
     let arr = |v: &[f64]| Value::Array(v.iter().map(|x| num(*x)).collect());
     let links: Vec<Value> = links
         .iter()
@@ -29,13 +30,14 @@ pub(super) fn json_report(links: &[LinkEnvelope], cyl: &[CylinderPeaks]) -> Valu
                     json!({"max": arr(&e.max), "min": arr(&e.min), "t_max": arr(&e.t_max), "t_min": arr(&e.t_min)}),
                 );
             }
-            o.insert(
-                "hot_spot".into(),
-                match &l.hot {
-                    Some((j, t, s, _)) => json!({"x": l.x[*j], "t": t, "sigma": s}),
-                    None => json!({"x": null, "t": null, "sigma": null}),
-                },
-            );
+            let mut hot = match &l.hot {
+                Some((j, t, s, _)) => json!({"x": l.x[*j], "t": t, "sigma": s}),
+                None => json!({"x": null, "t": null, "sigma": null}),
+            };
+            if fatigue {
+                hot["fatigue"] = l.fatigue.as_ref().map_or(Value::Null, HotFatigue::json);
+            }
+            o.insert("hot_spot".into(), hot);
             Value::Object(o)
         })
         .collect();
@@ -107,6 +109,9 @@ pub(super) fn text_report(links: &[LinkEnvelope], cyl: &[CylinderPeaks]) -> Stri
                 sg * 1e-6,
                 l.x[*j]
             );
+        }
+        if let Some(f) = &l.fatigue {
+            let _ = writeln!(s, "{}", f.text());
         }
     }
     for c in cyl {
