@@ -90,6 +90,7 @@ fn stress_json_has_the_fixed_shape_and_consistent_envelopes() {
         "stress-envelope-crane-link1.png",
         "stress-hot-spot-crane-link1.png",
         "stress-envelope-crane-link2.png",
+        "stress-boom-crane.png",
     ] {
         assert!(dir.path().join(f).metadata().unwrap().len() > 1000, "{f}");
     }

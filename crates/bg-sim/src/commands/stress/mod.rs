@@ -284,6 +284,23 @@ pub fn command(a: &Args) -> ExitCode {
             cyl_cols.push((c.clone(), cols, margin));
         }
     }
+    // with --plot, the ends of every link's chord: the pose of the boom figure
+    let mut poses: Vec<(String, Vec<(String, String)>)> = Vec::new();
+    if a.plot.is_some() {
+        for arm in &arms {
+            let mut ends = Vec::new();
+            for i in 1..=64 {
+                let (x, y) = (format!("{arm}_arm.x_e{i}"), format!("{arm}_arm.y_e{i}"));
+                if model.equations.probe(&x).is_none() || model.equations.probe(&y).is_none() {
+                    break;
+                }
+                add(&mut model, x.clone());
+                add(&mut model, y.clone());
+                ends.push((x, y));
+            }
+            poses.push((arm.clone(), ends));
+        }
+    }
     model.settings.interrupt = Some(interrupt_on_signals());
     let outcome = match model.run() {
         Ok(o) => o,
@@ -391,6 +408,7 @@ pub fn command(a: &Args) -> ExitCode {
         match figures(
             dir,
             &envelopes,
+            &poses,
             tr,
             model.title.as_deref().unwrap_or(model.file()),
         ) {

@@ -1,5 +1,6 @@
 //! The figures of `bg-sim stress --plot DIR`: each link's envelopes along x and its hot
-//! spot's history.
+//! spot's history; per arm, the boom drawn in the pose of its hot spot with the moment
+//! envelopes.
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -10,6 +11,7 @@ use super::{LinkEnvelope, QUANTITIES};
 pub(super) fn figures(
     dir: &std::path::Path,
     links: &[LinkEnvelope],
+    poses: &[(String, Vec<(String, String)>)],
     tr: &bondgraph::Trajectory,
     title: &str,
 ) -> Result<Vec<PathBuf>, String> {
@@ -128,5 +130,79 @@ pub(super) fn figures(
             );
         }
     }
+    for (arm, ends) in poses {
+        written.extend(boom_figure(dir, arm, ends, links, tr)?);
+    }
     Ok(written)
+}
+
+/// The arm `arm` drawn in the pose of its largest hot spot (the chords' ends `ends`, columns
+/// of `tr`) with each link's moment envelope: `stress-boom-<arm>.png`; nothing for an arm
+/// without a hot spot.
+fn boom_figure(
+    dir: &std::path::Path,
+    arm: &str,
+    ends: &[(String, String)],
+    links: &[LinkEnvelope],
+    tr: &bondgraph::Trajectory,
+) -> Result<Option<PathBuf>, String> {
+    let mine: Vec<&LinkEnvelope> = links.iter().filter(|l| l.arm == arm).collect();
+    let Some((hot_link, t_hot)) = mine
+        .iter()
+        .filter_map(|l| l.hot.as_ref().map(|h| (l.link, h.1, h.2)))
+        .max_by(|a, b| a.2.abs().total_cmp(&b.2.abs()))
+        .map(|(k, t, _)| (k, t))
+    else {
+        return Ok(None);
+    };
+    let t = tr.column("t").unwrap_or_default();
+    let Some(row) = t.iter().position(|v| *v == t_hot) else {
+        return Ok(None);
+    };
+    let mut start = (0.0, 0.0);
+    let mut drawn = Vec::new();
+    let empty: &[f64] = &[];
+    for (i, (cx, cy)) in ends.iter().enumerate() {
+        let (xs, ys) = (
+            tr.column(cx).unwrap_or_default(),
+            tr.column(cy).unwrap_or_default(),
+        );
+        let (Some(x), Some(y)) = (xs.get(row), ys.get(row)) else {
+            return Ok(None);
+        };
+        let end = (*x, *y);
+        let env = mine.iter().find(|l| l.link == i + 1);
+        drawn.push(bg_sim::plot::BoomLink {
+            start,
+            end,
+            x: env.map_or(empty, |l| &l.x),
+            max: env.map_or(empty, |l| &l.env[2].max),
+            min: env.map_or(empty, |l| &l.env[2].min),
+            label: format!("link {}: M envelope over the run (max to min)", i + 1),
+            hot: env.and_then(|l| {
+                l.hot.as_ref().map(|(j, th, s, _)| {
+                    (
+                        l.x[*j],
+                        format!(
+                            "hot spot of link {}: σ = {:.0} MPa at x = {:.2} m, t = {th:.2} s",
+                            l.link,
+                            s * 1e-6,
+                            l.x[*j]
+                        ),
+                    )
+                })
+            }),
+        });
+        start = end;
+    }
+    let path = dir.join(format!("stress-boom-{arm}.png"));
+    bg_sim::plot::boom_envelope(
+        &format!(
+            "{arm}: bending-moment envelopes, pose at t = {t_hot:.2} s (hot spot of link {hot_link})"
+        ),
+        &drawn,
+        &path,
+    )
+    .map(Some)
+    .map_err(|e| e.to_string())
 }
