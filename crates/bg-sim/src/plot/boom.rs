@@ -12,6 +12,9 @@ use plotters::prelude::*;
 
 use super::{font, significant, PlotError, FONT, PALETTE, TITLE_HEIGHT, WIDTH};
 
+/// Points in frame 0 (m).
+type Polyline = Vec<(f64, f64)>;
+
 /// One link of the drawing.
 pub struct BoomLink<'a> {
     /// Its joint and its end in frame 0 (m).
@@ -69,7 +72,7 @@ pub fn boom_envelope(
         let off = -m * scale;
         (l.start.0 + ux * x - uy * off, l.start.1 + uy * x + ux * off)
     };
-    let bands: Vec<(Vec<(f64, f64)>, Vec<(f64, f64)>)> = links
+    let bands: Vec<(Polyline, Polyline)> = links
         .iter()
         .map(|l| {
             let up: Vec<_> = (0..l.x.len())

@@ -156,7 +156,10 @@ fn boom_figure(
         return Ok(None);
     };
     let t = tr.column("t").unwrap_or_default();
-    let Some(row) = t.iter().position(|v| *v == t_hot) else {
+    // the hot spot's row (its time is one of the column's)
+    let Some(row) =
+        (0..t.len()).min_by(|&a, &b| (t[a] - t_hot).abs().total_cmp(&(t[b] - t_hot).abs()))
+    else {
         return Ok(None);
     };
     let mut start = (0.0, 0.0);
