@@ -83,7 +83,8 @@ enum Command {
     Fmu(fmu::Args),
     /// Stresses along the arm's flexible links over a run: envelopes of N, V, M and the
     /// outer-fibre σ (max and min at every section, with their times), the hot spot and its
-    /// history, the cylinders' peak pressures and forces (docs/stress.md).
+    /// history, the cylinders' peak pressures and forces (docs/stress.md); --fatigue CURVE
+    /// also the hot spots' rainflow count and Miner damage.
     Stress(stress::Args),
     /// Rainflow-count a column of a results CSV (ASTM E1049-85) and its Palmgren–Miner
     /// damage on an S–N curve (EN 1993-1-9, DNV-RP-C203 presets or explicit).

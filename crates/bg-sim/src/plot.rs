@@ -10,6 +10,7 @@
 //! are needed.
 
 mod bode;
+mod boom;
 mod contour;
 mod energy;
 mod fatigue;
@@ -27,6 +28,7 @@ use plotters::prelude::*;
 use plotters::style::register_font;
 
 pub use bode::bode;
+pub use boom::{boom_envelope, BoomLink};
 pub use contour::{contour, Map};
 pub use energy::{energy_bars, energy_segments, Segment};
 pub use fatigue::fatigue;

@@ -8,16 +8,23 @@
 //! is the smallest over the run of its rod check's `buckling_margin`
 //! (`bg_hydraulics::buckling`), `null` for a cylinder without one.
 
-use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use bg_model::Model;
 use bg_sim::registry;
 use bondgraph::Output;
-use serde_json::{json, Value};
 
 use super::{interrupt_on_signals, BAD_INPUT, FAILED};
+
+mod fatigue;
+mod plot;
+mod report;
+
+use fatigue::HotFatigue;
+
+use plot::figures;
+use report::{csv_report, json_report, text_report};
 
 /// How `bg-sim stress` reports.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
@@ -67,6 +74,15 @@ pub struct Args {
     /// the run).
     #[arg(long, value_name = "DATA.csv")]
     pub inputs: Option<PathBuf>,
+    /// Rainflow-count each link's hot-spot history and give its Miner damage on this S–N
+    /// curve (as `bg-sim fatigue --sn`): a preset (`ec3-71`, `dnv-d`, …) or
+    /// `m=3,range=71e6,cycles=2e6[,knee=5e6,m2=5,cutoff=1e8]` (range in Pa).
+    #[arg(long, value_name = "CURVE")]
+    pub fatigue: Option<String>,
+    /// With --fatigue: the run repeats N times a year (the residue closed by the repetition,
+    /// the life also in years).
+    #[arg(long, value_name = "N", requires = "fatigue")]
+    pub repeat_per_year: Option<f64>,
 }
 
 /// The quantities of the envelopes, in the JSON's order.
@@ -82,6 +98,8 @@ struct LinkEnvelope {
     has_sigma: bool,
     /// (x index, t, σ) of the largest |σ|, and the column of its history.
     hot: Option<(usize, f64, f64, String)>,
+    /// The hot spot's fatigue (`--fatigue`).
+    fatigue: Option<HotFatigue>,
 }
 
 /// The max and min of a quantity at each x over the run, with their times.
@@ -152,6 +170,18 @@ pub fn command(a: &Args) -> ExitCode {
     }
     if a.points < 2 || a.points > 4096 {
         return bad(format!("--points {}: needs 2 to 4096", a.points));
+    }
+    let curve = match a.fatigue.as_deref().map(bg_fatigue::SnCurve::parse) {
+        None => None,
+        Some(Ok(c)) => Some(c),
+        Some(Err(e)) => return bad(format!("--fatigue: {e}")),
+    };
+    if let Some(n) = a.repeat_per_year {
+        if !(n.is_finite() && n > 0.0) {
+            return bad(format!(
+                "--repeat-per-year {n}: expected a finite number > 0\n  hint: --repeat-per-year 2000"
+            ));
+        }
     }
     let cylinders = elements_of_kind(&text, "hydraulics.cylinder");
     let mut sets = a.set.clone();
@@ -254,6 +284,23 @@ pub fn command(a: &Args) -> ExitCode {
             cyl_cols.push((c.clone(), cols, margin));
         }
     }
+    // with --plot, the ends of every link's chord: the pose of the boom figure
+    let mut poses: Vec<(String, Vec<(String, String)>)> = Vec::new();
+    if a.plot.is_some() {
+        for arm in &arms {
+            let mut ends = Vec::new();
+            for i in 1..=64 {
+                let (x, y) = (format!("{arm}_arm.x_e{i}"), format!("{arm}_arm.y_e{i}"));
+                if model.equations.probe(&x).is_none() || model.equations.probe(&y).is_none() {
+                    break;
+                }
+                add(&mut model, x.clone());
+                add(&mut model, y.clone());
+                ends.push((x, y));
+            }
+            poses.push((arm.clone(), ends));
+        }
+    }
     model.settings.interrupt = Some(interrupt_on_signals());
     let outcome = match model.run() {
         Ok(o) => o,
@@ -319,6 +366,15 @@ pub fn command(a: &Args) -> ExitCode {
             x,
             env,
             has_sigma: *sigma,
+            fatigue: curve.as_ref().zip(hot.as_ref()).and_then(|(c, h)| {
+                let history = col(&h.3);
+                if history.iter().all(|v| v.is_finite()) {
+                    Some(HotFatigue::of(&history, &h.3, c, a.repeat_per_year))
+                } else {
+                    tell!("warning: {arm} link {k}: the hot spot's history is not finite: no fatigue count");
+                    None
+                }
+            }),
             hot,
         });
     }
@@ -344,7 +400,7 @@ pub fn command(a: &Args) -> ExitCode {
         tell!("warning: {}: buckling_margin is null: the cylinder has no rod check (rod_d, E, buckling; docs/fatigue.md)", c.name);
     }
     match a.format {
-        StressFormat::Json => say!("{:#}", json_report(&envelopes, &peaks)),
+        StressFormat::Json => say!("{:#}", json_report(&envelopes, &peaks, curve.is_some())),
         StressFormat::Csv => say!("{}", csv_report(&envelopes).trim_end()),
         StressFormat::Text => say!("{}", text_report(&envelopes, &peaks).trim_end()),
     }
@@ -352,6 +408,7 @@ pub fn command(a: &Args) -> ExitCode {
         match figures(
             dir,
             &envelopes,
+            &poses,
             tr,
             model.title.as_deref().unwrap_or(model.file()),
         ) {
@@ -367,255 +424,4 @@ pub fn command(a: &Args) -> ExitCode {
         }
     }
     code
-}
-
-fn num(v: f64) -> Value {
-    if v.is_finite() {
-        json!(v)
-    } else {
-        Value::Null
-    }
-}
-
-fn json_report(links: &[LinkEnvelope], cyl: &[CylinderPeaks]) -> Value {
-    let arr = |v: &[f64]| Value::Array(v.iter().map(|x| num(*x)).collect());
-    let links: Vec<Value> = links
-        .iter()
-        .map(|l| {
-            let mut o = serde_json::Map::new();
-            o.insert("link".into(), json!(l.link));
-            o.insert("x".into(), arr(&l.x));
-            for (q, e) in QUANTITIES.iter().zip(&l.env) {
-                o.insert(
-                    (*q).into(),
-                    json!({"max": arr(&e.max), "min": arr(&e.min), "t_max": arr(&e.t_max), "t_min": arr(&e.t_min)}),
-                );
-            }
-            o.insert(
-                "hot_spot".into(),
-                match &l.hot {
-                    Some((j, t, s, _)) => json!({"x": l.x[*j], "t": t, "sigma": s}),
-                    None => json!({"x": null, "t": null, "sigma": null}),
-                },
-            );
-            Value::Object(o)
-        })
-        .collect();
-    let cylinders: Vec<Value> = cyl
-        .iter()
-        .map(|c| {
-            json!({"name": c.name, "p_max": num(c.p_max), "force_push_max": num(c.push),
-                   "force_pull_max": num(c.pull), "buckling_margin": c.margin.map_or(Value::Null, num)})
-        })
-        .collect();
-    json!({"links": links, "cylinders": cylinders})
-}
-
-fn csv_report(links: &[LinkEnvelope]) -> String {
-    let mut s = String::from("arm,link,x");
-    for q in QUANTITIES {
-        let _ = write!(s, ",{q}_max,{q}_t_max,{q}_min,{q}_t_min");
-    }
-    s.push('\n');
-    for l in links {
-        for (j, x) in l.x.iter().enumerate() {
-            let _ = write!(s, "{},{},{x}", l.arm, l.link);
-            for e in &l.env {
-                let _ = write!(
-                    s,
-                    ",{},{},{},{}",
-                    e.max[j], e.t_max[j], e.min[j], e.t_min[j]
-                );
-            }
-            s.push('\n');
-        }
-    }
-    s
-}
-
-fn text_report(links: &[LinkEnvelope], cyl: &[CylinderPeaks]) -> String {
-    let mut s = String::new();
-    for l in links {
-        let _ = writeln!(
-            s,
-            "{} link {}: {} sections, x = 0 … {} m",
-            l.arm,
-            l.link,
-            l.x.len(),
-            l.x.last().copied().unwrap_or(0.0)
-        );
-        let units = [
-            ("N", 1e-3, "kN"),
-            ("V", 1e-3, "kN"),
-            ("M", 1e-3, "kN·m"),
-            ("sigma_top", 1e-6, "MPa"),
-            ("sigma_bottom", 1e-6, "MPa"),
-        ];
-        for ((q, scale, unit), e) in units.iter().zip(&l.env) {
-            if q.starts_with("sigma") && !l.has_sigma {
-                continue;
-            }
-            let (jmax, jmin) = (argmax(&e.max), argmin(&e.min));
-            let _ = writeln!(
-                s,
-                "  {q:<13} max {:>10.3} {unit} at x = {:.3} m, t = {:.3} s;  min {:>10.3} {unit} at x = {:.3} m, t = {:.3} s",
-                e.max[jmax] * scale, l.x[jmax], e.t_max[jmax], e.min[jmin] * scale, l.x[jmin], e.t_min[jmin]
-            );
-        }
-        if let Some((j, t, sg, _)) = &l.hot {
-            let _ = writeln!(
-                s,
-                "  hot spot: σ = {:.3} MPa at x = {:.3} m, t = {t:.3} s",
-                sg * 1e-6,
-                l.x[*j]
-            );
-        }
-    }
-    for c in cyl {
-        let _ = writeln!(
-            s,
-            "cylinder {}: p_max {:.3} MPa, push {:.1} kN, pull {:.1} kN, buckling margin {}",
-            c.name,
-            c.p_max * 1e-6,
-            c.push * 1e-3,
-            c.pull * 1e-3,
-            c.margin.map_or_else(
-                || "not declared".to_owned(),
-                |m| format!("{m:.3} (smallest of the run)")
-            )
-        );
-    }
-    s
-}
-
-fn argmax(v: &[f64]) -> usize {
-    (0..v.len()).fold(0, |b, j| if v[j] > v[b] { j } else { b })
-}
-fn argmin(v: &[f64]) -> usize {
-    (0..v.len()).fold(0, |b, j| if v[j] < v[b] { j } else { b })
-}
-
-/// The envelope of each link along x (N, V, M, σ) and the hot spots' histories.
-fn figures(
-    dir: &std::path::Path,
-    links: &[LinkEnvelope],
-    tr: &bondgraph::Trajectory,
-    title: &str,
-) -> Result<Vec<PathBuf>, String> {
-    use bg_model::plots::{Panel, Plot, Series};
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    let series = |column: &str, label: &str, scale: f64, dashed: bool| Series {
-        column: column.to_owned(),
-        label: label.to_owned(),
-        scale,
-        offset: 0.0,
-        dashed,
-        line: 0,
-    };
-    let mut written = Vec::new();
-    for l in links {
-        // the plotting reads a CSV whose first column is `t`: here it holds x
-        let mut csv = String::from("t");
-        for q in QUANTITIES {
-            let _ = write!(csv, ",{q}_max,{q}_min");
-        }
-        csv.push('\n');
-        for j in 0..l.x.len() {
-            let _ = write!(csv, "{}", l.x[j]);
-            for e in &l.env {
-                let _ = write!(csv, ",{},{}", e.max[j], e.min[j]);
-            }
-            csv.push('\n');
-        }
-        let results = bg_sim::plot::Results::parse(&csv).map_err(|(_, m)| m)?;
-        let panel = |y: &str, unit: &str, cols: &[(&str, &str, f64, bool)]| Panel {
-            y_label: y.to_owned(),
-            unit: Some(unit.to_owned()),
-            x_range: None,
-            series: cols
-                .iter()
-                .map(|(c, lab, s, d)| series(c, lab, *s, *d))
-                .collect(),
-            line: 0,
-        };
-        let mut panels = vec![
-            panel(
-                "bending moment",
-                "kN·m",
-                &[
-                    ("M_max", "max over the run", 1e-3, false),
-                    ("M_min", "min over the run", 1e-3, true),
-                ],
-            ),
-            panel(
-                "shear force",
-                "kN",
-                &[("V_max", "max", 1e-3, false), ("V_min", "min", 1e-3, true)],
-            ),
-            panel(
-                "axial force",
-                "kN",
-                &[("N_max", "max", 1e-3, false), ("N_min", "min", 1e-3, true)],
-            ),
-        ];
-        if l.has_sigma {
-            panels.push(panel(
-                "normal stress",
-                "MPa",
-                &[
-                    ("sigma_top_max", "top fibre, max", 1e-6, false),
-                    ("sigma_top_min", "top fibre, min", 1e-6, true),
-                    ("sigma_bottom_max", "bottom fibre, max", 1e-6, false),
-                    ("sigma_bottom_min", "bottom fibre, min", 1e-6, true),
-                ],
-            ));
-        }
-        let plot = Plot {
-            file: format!("stress-envelope-{}-link{}", l.arm, l.link),
-            title: format!("{title}: link {} envelopes over the run", l.link),
-            x: "t".to_owned(),
-            x_label: "distance from the joint along the link [m]".to_owned(),
-            panels,
-            line: 0,
-        };
-        written.extend(
-            bg_sim::plot::draw(&results, &plot, dir, bg_sim::plot::Format::Png)
-                .map_err(|e| e.to_string())?,
-        );
-        if let Some((j, _, _, column)) = &l.hot {
-            let hist = tr.column(column).unwrap_or_default();
-            let t = tr.column("t").unwrap_or_default();
-            let mut csv = String::from("t,sigma\n");
-            for (a, b) in t.iter().zip(&hist) {
-                let _ = writeln!(csv, "{a},{b}");
-            }
-            let results = bg_sim::plot::Results::parse(&csv).map_err(|(_, m)| m)?;
-            let plot = Plot {
-                file: format!("stress-hot-spot-{}-link{}", l.arm, l.link),
-                title: format!(
-                    "{title}: link {} hot spot at x = {:.3} m ({})",
-                    l.link,
-                    l.x[*j],
-                    if column.contains("sigma_top") {
-                        "top fibre"
-                    } else {
-                        "bottom fibre"
-                    }
-                ),
-                x: "t".to_owned(),
-                x_label: "time [s]".to_owned(),
-                panels: vec![panel(
-                    "normal stress",
-                    "MPa",
-                    &[("sigma", "σ at the hot spot", 1e-6, false)],
-                )],
-                line: 0,
-            };
-            written.extend(
-                bg_sim::plot::draw(&results, &plot, dir, bg_sim::plot::Format::Png)
-                    .map_err(|e| e.to_string())?,
-            );
-        }
-    }
-    Ok(written)
 }
