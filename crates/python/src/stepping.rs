@@ -76,9 +76,32 @@ fn check_cover(file: &str, name: &str, times: &[f64], t0: f64, t1: f64) -> Resul
 pub struct Sim {
     s: Stepping,
     probes: HashMap<String, Probe>,
+    /// Inputs that follow data and may not be stepped past its end: (name, last sample's
+    /// time, where the data came from). Data given with `extrapolate="hold"` are not here.
+    ends: Vec<(String, f64, &'static str)>,
+    /// Inputs driven by the data given to `start`: `set_input` refuses to override them.
+    from_start: Vec<String>,
+}
+
+/// The tolerance of a comparison of times near `t`.
+fn time_tol(t: f64) -> f64 {
+    1e-9 * (1.0 + t.abs())
 }
 
 impl Sim {
+    /// Refuse to advance to `t` past the end of an input's data (unless it was given with
+    /// `extrapolate="hold"`), as `run` refuses a run longer than its data.
+    fn check_ends(&self, t: f64) -> PyResult<()> {
+        for (name, last, origin) in &self.ends {
+            if t > last + time_tol(*last) {
+                return Err(other_error(format!(
+                    "input `{name}`: the {origin} end at t = {last} s; cannot advance to t = {t} s past them\n  hint: add samples up to t = {t} s, or pass extrapolate=\"hold\" to hold the last value"
+                )));
+            }
+        }
+        Ok(())
+    }
+
     fn probe(&mut self, py: Python<'_>, name: &str) -> PyResult<Probe> {
         if let Some(p) = self.probes.get(name) {
             return Ok(*p);
@@ -99,11 +122,13 @@ impl Sim {
 
     /// Advance to `t`, landing on it exactly.
     fn advance_to(&mut self, py: Python<'_>, t: f64) -> PyResult<()> {
+        self.check_ends(t)?;
         self.s.advance_to(t).map_err(|e| model_error(py, &e))
     }
 
     /// Advance by `dt`.
     fn advance(&mut self, py: Python<'_>, dt: f64) -> PyResult<()> {
+        self.check_ends(self.s.t() + dt)?;
         self.s.advance(dt).map_err(|e| model_error(py, &e))
     }
 
@@ -134,13 +159,24 @@ impl Sim {
     }
 
     /// Hold the input `name` at `value`.
+    /// An input driven by the data given to `start` is refused (the data rule it); a
+    /// series given by `set_input_series` is replaced (the latest call rules).
     fn set_input(&mut self, py: Python<'_>, name: &str, value: f64) -> PyResult<()> {
+        if self.from_start.iter().any(|n| n == name) {
+            return Err(other_error(format!(
+                "input `{name}` follows the data given to `start`: setting it to {value} would override them\n  hint: leave `{name}` out of the start's inputs to set it call by call, or give it new data with set_inputs({name}=series)"
+            )));
+        }
         self.s
             .set_input(name, value)
-            .map_err(|e| model_error(py, &e))
+            .map_err(|e| model_error(py, &e))?;
+        self.ends.retain(|(n, _, _)| n != name);
+        Ok(())
     }
 
-    /// Make the input `name` follow (times, values) from now on.
+    /// Make the input `name` follow (times, values) from now on. Unless `extrapolate`, the
+    /// data must start at or before now, and advancing past their end is refused.
+    #[pyo3(signature = (name, times, values, interp, extrapolate=false))]
     fn set_input_series(
         &mut self,
         py: Python<'_>,
@@ -148,11 +184,26 @@ impl Sim {
         times: Vec<f64>,
         values: Vec<f64>,
         interp: &str,
+        extrapolate: bool,
     ) -> PyResult<()> {
         let series = series("input data", name, times, values, interp).map_err(other_error)?;
+        let (first, last) = (series.times()[0], series.times()[series.times().len() - 1]);
+        let now = self.s.t();
+        if !extrapolate && first > now + time_tol(now) {
+            return Err(other_error(format!(
+                "input `{name}`: the data start at t = {first} s, after the current time t = {now} s\n  hint: add a sample at t = {now} s, or pass extrapolate=\"hold\" to hold the first value"
+            )));
+        }
         self.s
             .set_input_series(name, series)
-            .map_err(|e| model_error(py, &e))
+            .map_err(|e| model_error(py, &e))?;
+        self.from_start.retain(|n| n != name);
+        self.ends.retain(|(n, _, _)| n != name);
+        if !extrapolate {
+            self.ends
+                .push((name.to_owned(), last, "data given to set_inputs"));
+        }
+        Ok(())
     }
 
     /// The inputs' names.
@@ -215,22 +266,41 @@ fn lin_dict<'py>(py: Python<'py>, lin: &Linearization) -> PyResult<Bound<'py, Py
     Ok(d)
 }
 
-/// Load a model (with `--set` overrides and input data) and start it at `t0`.
+/// Load a model (with `--set` overrides and input data) and start it at `t0`. Unless
+/// `extrapolate`, the data must start at or before `t0`, and advancing past their end is
+/// refused (as `run` refuses a run longer than its data).
 #[pyfunction]
-#[pyo3(signature = (path, set, t0=None, inputs=Vec::new()))]
+#[pyo3(signature = (path, set, t0=None, inputs=Vec::new(), extrapolate=false))]
 pub fn start(
     py: Python<'_>,
     path: PathBuf,
     set: Vec<String>,
     t0: Option<f64>,
     inputs: Vec<InputData>,
+    extrapolate: bool,
 ) -> PyResult<Sim> {
     let mut m = Model::load(&path, &bg_sim::registry(), &set).map_err(|e| model_error(py, &e))?;
-    set_series(&mut m, inputs, None, true).map_err(other_error)?;
+    let t_start = t0.unwrap_or(m.settings.t_start);
+    let from_start: Vec<String> = inputs.iter().map(|d| d.0.clone()).collect();
+    let ends = if extrapolate {
+        Vec::new()
+    } else {
+        inputs
+            .iter()
+            .filter_map(|d| {
+                d.1.last()
+                    .map(|&last| (d.0.clone(), last, "data given to start"))
+            })
+            .collect()
+    };
+    // the start is checked here; the end when advancing (the run has no fixed end)
+    set_series(&mut m, inputs, Some((t_start, t_start)), extrapolate).map_err(other_error)?;
     let s = m.start(t0).map_err(|e: ModelError| model_error(py, &e))?;
     Ok(Sim {
         s,
         probes: HashMap::new(),
+        ends,
+        from_start,
     })
 }
 

@@ -208,18 +208,30 @@ class Simulation:
         names, values = self._sim.state()
         return pd.Series(values, index=names, dtype=np.float64, name=self.t)
 
-    def set_inputs(self, values: Optional[Mapping[str, Any]] = None, **kw: Any) -> "Simulation":
+    def set_inputs(
+        self,
+        values: Optional[Mapping[str, Any]] = None,
+        extrapolate: Optional[str] = None,
+        **kw: Any,
+    ) -> "Simulation":
         """Set inputs by name: a number holds the input at that value from now on; a pandas
         Series indexed by time or a ``(times, values)`` pair makes it follow that data
         (linear between samples; its sample times become stops). ``sim.set_inputs(F=10.0)``
-        or ``sim.set_inputs({"F": 10.0})``."""
+        or ``sim.set_inputs({"F": 10.0})``.
+
+        As for :meth:`Model.run`, data must start at or before now, and advancing past
+        their last sample raises :class:`BgSimError`, unless ``extrapolate="hold"`` (then
+        the ends are held). An input driven by the data given to :meth:`Model.start` cannot
+        be set to a number (:class:`BgSimError`); new data for it replace the old."""
+        if extrapolate not in (None, "hold"):
+            raise BgSimError(f"extrapolate={extrapolate!r}: only \"hold\" (or None) is known")
         all_values = {**dict(values or {}), **kw}
         for name, v in all_values.items():
             if isinstance(v, (int, float, np.floating, np.integer)):
                 self._sim.set_input(name, float(v))
             else:
                 for n, t, vals, interp in _input_data({name: v}, "linear"):
-                    self._sim.set_input_series(n, t, vals, interp)
+                    self._sim.set_input_series(n, t, vals, interp, extrapolate == "hold")
         return self
 
     def stats(self) -> Dict[str, Any]:
@@ -402,16 +414,22 @@ class Model:
         t0: Optional[float] = None,
         inputs: Optional[InputData] = None,
         inputs_interp: str = "linear",
+        extrapolate: Optional[str] = None,
     ) -> Simulation:
         """Start the model at ``t0`` (its ``t_start`` if None) to be advanced call by call:
         ``sim.set_inputs(F=10.0)``, ``sim.advance_to(t)`` / ``sim.advance(dt)``,
         ``sim.get("x")``, ``sim.state()``, ``sim.t``. ``inputs`` gives inputs data from the
-        start (as for :meth:`run`). Each call to ``start`` loads the file anew."""
+        start (as for :meth:`run`): they must start at or before ``t0``, and advancing past
+        their last sample raises :class:`BgSimError`, unless ``extrapolate="hold"``. Each
+        call to ``start`` loads the file anew."""
+        if extrapolate not in (None, "hold"):
+            raise BgSimError(f"extrapolate={extrapolate!r}: only \"hold\" (or None) is known")
         sim = _bgsim.start(
             self.path,
             _overrides(self.set),
             None if t0 is None else float(t0),
             _input_data(inputs, inputs_interp),
+            extrapolate == "hold",
         )
         return Simulation(sim, self)
 
