@@ -77,3 +77,24 @@ def test_set_inputs_number_on_an_input_the_start_data_drive_is_refused():
     sim.set_inputs(F=([0.5, 3.0], [0.0, 0.0]))
     sim.advance_to(3.0)
     assert sim.get("F") == 0.0
+
+
+def test_a_simulation_used_from_another_thread_raises_bgsimerror():
+    import threading
+
+    sim = bgsim.load(MSD).start()
+    caught = []
+
+    def use():
+        try:
+            sim.advance_to(0.1)
+        except BaseException as e:  # a PanicException is a BaseException
+            caught.append(e)
+
+    th = threading.Thread(target=use)
+    th.start()
+    th.join()
+    assert len(caught) == 1 and isinstance(caught[0], bgsim.BgSimError), caught
+    assert "another thread" in str(caught[0])
+    sim.advance_to(0.1)  # still usable on its own thread
+    assert sim.t == pytest.approx(0.1, abs=1e-14)

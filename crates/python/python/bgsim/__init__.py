@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import json
 import os
+import threading
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Union
 
 import numpy as np
@@ -168,7 +169,9 @@ class Simulation:
     """
 
     def __init__(self, sim: Any, model: "Model"):
-        self._sim = sim
+        self._owner = sim
+        #: The thread that started it: the compiled simulation stays on that thread.
+        self._thread = threading.get_ident()
         self.model = model
         #: The inputs' names.
         self.inputs: List[str] = list(sim.input_names())
@@ -177,6 +180,17 @@ class Simulation:
 
     def __repr__(self) -> str:
         return f"bgsim.Simulation({self.model.path!r}, t={self.t})"
+
+    @property
+    def _sim(self) -> Any:
+        # the compiled simulation cannot cross threads (PyO3 would raise a PanicException)
+        if threading.get_ident() != self._thread:
+            raise BgSimError(
+                "this Simulation was started on another thread and can only be used there\n"
+                "  hint: call model.start() on the thread that advances it (one Simulation "
+                "per thread)"
+            )
+        return self._owner
 
     @property
     def t(self) -> float:
