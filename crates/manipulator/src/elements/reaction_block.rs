@@ -46,6 +46,26 @@ pub struct ReactionInputs {
     pub tip_load: Option<[String; 2]>,
 }
 
+impl ReactionInputs {
+    /// The signals read, in the order a block's `io.input(k)` sees them: q, u, u̇ (n each),
+    /// one force per actuator, the springs' pin forces (2 per spring), then the base's four
+    /// and the tip load's two where given.
+    pub fn signal_specs(&self, n: usize, n_springs: usize) -> Vec<SignalSpec> {
+        let v = |name: &str, dim| SignalSpec {
+            name: name.to_owned(),
+            dim,
+        };
+        let mut s = vec![v(&self.q, n), v(&self.u, n), v(&self.udot, n)];
+        s.extend(self.forces.iter().map(|f| v(f, 1)));
+        if let Some(p) = &self.pin_forces {
+            s.push(v(p, 2 * n_springs));
+        }
+        s.extend(self.base.iter().flatten().map(|b| v(b, 1)));
+        s.extend(self.tip_load.iter().flatten().map(|b| v(b, 1)));
+        s
+    }
+}
+
 /// The reaction-force block of a [`PlanarArm`].
 #[derive(Debug)]
 pub struct ArmReactions {
@@ -165,23 +185,7 @@ impl Element for ArmReactions {
         CausalRule::None
     }
     fn signal_inputs(&self) -> Vec<SignalSpec> {
-        let n = self.arm.n();
-        let v = |name: &str, dim| SignalSpec {
-            name: name.to_owned(),
-            dim,
-        };
-        let mut s = vec![
-            v(&self.inputs.q, n),
-            v(&self.inputs.u, n),
-            v(&self.inputs.udot, n),
-        ];
-        s.extend(self.inputs.forces.iter().map(|f| v(f, 1)));
-        if let Some(p) = &self.inputs.pin_forces {
-            s.push(v(p, 2 * self.springs.len()));
-        }
-        s.extend(self.inputs.base.iter().flatten().map(|b| v(b, 1)));
-        s.extend(self.inputs.tip_load.iter().flatten().map(|b| v(b, 1)));
-        s
+        self.inputs.signal_specs(self.arm.n(), self.springs.len())
     }
     fn signal_outputs(&self) -> Vec<SignalSpec> {
         let mut out: Vec<SignalSpec> = (1..=self.n_rho())

@@ -210,21 +210,8 @@ impl Element for ArmStress {
         CausalRule::None
     }
     fn signal_inputs(&self) -> Vec<SignalSpec> {
-        let n = self.arm.n();
-        let v = |name: &str, dim| SignalSpec {
-            name: name.to_owned(),
-            dim,
-        };
-        let mut s = vec![
-            v(&self.inputs.q, n),
-            v(&self.inputs.u, n),
-            v(&self.inputs.udot, n),
-        ];
-        s.extend(self.inputs.forces.iter().map(|f| v(f, 1)));
-        if let Some(p) = &self.inputs.pin_forces {
-            s.push(v(p, 2 * self.springs.len()));
-        }
-        s
+        // the reaction block's inputs (the scene refuses a base or a tip load with stress)
+        self.inputs.signal_specs(self.arm.n(), self.springs.len())
     }
     fn signal_outputs(&self) -> Vec<SignalSpec> {
         let mut out = Vec::new();
